@@ -1,0 +1,64 @@
+"""Preallocated float32 ring replay buffer (numpy; no torch, no environment)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+FIELDS = ("obs", "action", "reward", "next_obs", "terminated")
+
+
+class ReplayBuffer:
+    """Fixed-capacity FIFO of transitions (s, a, r, s', terminated).
+
+    ``terminated`` is 1.0 only when the episode really ended (fall or finish); time-limit
+    truncations are stored as 0.0 so that their targets bootstrap.
+    """
+
+    def __init__(self, capacity: int, obs_dim: int, act_dim: int) -> None:
+        self.capacity, self.obs_dim, self.act_dim = capacity, obs_dim, act_dim
+        self.obs = np.zeros((capacity, obs_dim), np.float32)
+        self.action = np.zeros((capacity, act_dim), np.float32)
+        self.reward = np.zeros((capacity,), np.float32)
+        self.next_obs = np.zeros((capacity, obs_dim), np.float32)
+        self.terminated = np.zeros((capacity,), np.float32)
+        self.pos = 0  # next slot to write
+        self.size = 0  # filled slots
+
+    def __len__(self) -> int:
+        return self.size
+
+    def add(self, obs, action, reward: float, next_obs, terminated: bool) -> None:
+        i = self.pos
+        self.obs[i] = obs
+        self.action[i] = action
+        self.reward[i] = reward
+        self.next_obs[i] = next_obs
+        self.terminated[i] = float(terminated)
+        self.pos = (i + 1) % self.capacity
+        self.size = min(self.size + 1, self.capacity)
+
+    def sample(self, batch_size: int, rng: np.random.Generator) -> dict[str, np.ndarray]:
+        """Uniform sample with replacement: obs (B, obs_dim), action (B, act_dim), reward (B,)..."""
+        if self.size == 0:
+            raise ValueError("cannot sample from an empty replay buffer")
+        idx = rng.integers(0, self.size, size=batch_size)
+        return {name: getattr(self, name)[idx] for name in FIELDS}
+
+    def state_dict(self) -> dict:
+        """The filled slots in storage order plus the write position.
+
+        Storage order (not chronological order) is kept so that the same sampled indices pick
+        the same transitions after a resume.
+        """
+        data = {name: getattr(self, name)[: self.size].copy() for name in FIELDS}
+        return {"capacity": self.capacity, "size": self.size, "pos": self.pos, **data}
+
+    def load_state_dict(self, state: dict) -> None:
+        size, pos = int(state["size"]), int(state["pos"])
+        if size > self.capacity or not 0 <= pos < self.capacity:
+            raise ValueError(
+                f"buffer state (size {size}, pos {pos}) does not fit capacity {self.capacity}"
+            )
+        for name in FIELDS:
+            getattr(self, name)[:size] = state[name]
+        self.size, self.pos = size, pos

@@ -1,0 +1,129 @@
+"""Checkpoint files: one training-state file for exact resume, one small policy file.
+
+Both are ``torch.save`` dicts holding only tensors and plain Python values (loaded with
+``weights_only=True``), tagged with ``format`` and ``version``. Writes are atomic: the data goes to
+a temporary file in the same directory, is fsynced, then renamed over the old file, so a crash or
+kill at any moment leaves the previous checkpoint intact.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import torch
+
+from .errors import UserError
+
+FORMAT_VERSION = 1
+TRAIN_FORMAT = "bipedal-train-state"
+POLICY_FORMAT = "bipedal-policy"
+STATE_FILE = "state.pt"
+POLICY_FILE = "policy.pt"
+
+
+def atomic_save(obj: Any, path: str | Path) -> None:
+    """torch.save to ``path`` through a temporary file and ``os.replace``."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        os.chmod(tmp, 0o644)  # mkstemp makes it owner-only; a checkpoint is a normal file
+        with os.fdopen(fd, "wb") as f:
+            torch.save(obj, f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def load_checkpoint(path: str | Path, option: str = "CKPT") -> dict[str, Any]:
+    """Load a policy or training-state file; every failure is a one-line :class:`UserError`."""
+    path = Path(path)
+    if path.is_dir():
+        for name in (STATE_FILE, POLICY_FILE):
+            if (path / name).is_file():
+                return load_checkpoint(path / name, option)
+        raise UserError(f"{option} {path}: directory holds no {STATE_FILE} or {POLICY_FILE}")
+    if not path.is_file():
+        raise UserError(f"{option} {path}: no such file")
+    try:
+        data = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception:
+        raise UserError(
+            f"{option} {path}: not a readable bipedal checkpoint (truncated, corrupted or another "
+            "format); expected a file written by `bipedal train`"
+        ) from None
+    if not isinstance(data, dict) or data.get("format") not in (TRAIN_FORMAT, POLICY_FORMAT):
+        raise UserError(
+            f"{option} {path}: not a bipedal checkpoint; expected a policy.pt or state.pt "
+            "written by `bipedal train`"
+        )
+    if int(data.get("version", -1)) > FORMAT_VERSION:
+        raise UserError(
+            f"{option} {path}: checkpoint format version {data.get('version')} is newer than "
+            f"this bipedal supports ({FORMAT_VERSION}); upgrade bipedal"
+        )
+    data["path"] = str(path)
+    return data
+
+
+def policy_payload(
+    actor_state: dict, config: dict, obs_dim: int, act_dim: int, meta: dict
+) -> dict[str, Any]:
+    return {
+        "format": POLICY_FORMAT,
+        "version": FORMAT_VERSION,
+        "config": config,
+        "env": config["env"],
+        "obs_dim": obs_dim,
+        "act_dim": act_dim,
+        "actor": {k: v.detach().cpu().clone() for k, v in actor_state.items()},
+        "meta": meta,
+    }
+
+
+def actor_from_checkpoint(data: dict[str, Any], option: str = "CKPT"):
+    """Build the deterministic actor a policy or training-state checkpoint holds (on CPU)."""
+    from .agent import make_actor
+    from .config import config_from_dict
+
+    cfg = config_from_dict(data["config"], f"{option} {data.get('path', '')}: config".strip())
+    actor_state = data["actor"] if data["format"] == POLICY_FORMAT else data["agent"]["actor"]
+    actor = make_actor(cfg.agent, int(data["obs_dim"]), int(data["act_dim"]))
+    try:
+        actor.load_state_dict(actor_state)
+    except RuntimeError:
+        raise UserError(
+            f"{option} {data.get('path')}: actor weights do not match its own config"
+        ) from None
+    actor.eval()
+    return actor, cfg
+
+
+def check_dims(data: dict[str, Any], obs_dim: int, act_dim: int, env_id: str, option="CKPT"):
+    if (int(data["obs_dim"]), int(data["act_dim"])) != (obs_dim, act_dim):
+        raise UserError(
+            f"{option} {data.get('path')}: policy is for observations of size {data['obs_dim']} "
+            f"and actions of size {data['act_dim']}; {env_id} has {obs_dim} and {act_dim}"
+        )
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    """Write a text file (JSON reports) through a temporary file and ``os.replace``."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    try:
+        os.chmod(tmp, 0o644)
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise

@@ -1,0 +1,290 @@
+"""Typed configuration: dataclasses with defaults, filled from YAML, overridden by ``--set``.
+
+Precedence, resolved in one place (:func:`resolve_config`): ``--set key=value`` wins over the
+YAML file, the YAML file over the dataclass defaults. Unknown keys and wrong types raise
+:class:`~bipedal_cli.errors.UserError` naming the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import types
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .errors import UserError
+
+ENV_ALIASES = {
+    "walker": "BipedalWalker-v3",
+    "hardcore": "BipedalWalkerHardcore-v3",
+}
+KNOWN_ENVS = tuple(ENV_ALIASES.values())
+
+
+def canonical_env_id(name: str, option: str = "--env") -> str:
+    """Map ``walker``/``hardcore`` or a full Gymnasium id to the full id; reject anything else."""
+    if name in ENV_ALIASES:
+        return ENV_ALIASES[name]
+    if name in KNOWN_ENVS:
+        return name
+    expected = ", ".join([*ENV_ALIASES, *KNOWN_ENVS])
+    raise UserError(f"{option}: unknown environment {name!r}; expected one of {expected}")
+
+
+@dataclass
+class AgentConfig:
+    """TQC + D2RL hyperparameters (paper Table 1; see configs/walker.yaml for the choices)."""
+
+    gamma: float = 0.98
+    """Discount factor."""
+    lr: float = 3.296e-4
+    """Adam learning rate for actor, critics and temperature."""
+    batch_size: int = 64
+    """Transitions per gradient step."""
+    tau: float = 0.005
+    """Polyak rate of the target critics: target <- tau * online + (1 - tau) * target."""
+    n_critics: int = 5
+    """N: critics in the ensemble."""
+    n_quantiles: int = 25
+    """M: quantile atoms per critic."""
+    drop_per_critic: int = 2
+    """k: atoms dropped from the top of the pooled target per critic (k * N in all)."""
+    actor_hidden: int = 512
+    """Width of the actor's hidden layers."""
+    critic_hidden: int = 256
+    """Width of each critic's hidden layers."""
+    n_layers: int = 2
+    """Hidden layers per network."""
+    d2rl: bool = True
+    """Concatenate the network input to every hidden layer's output (False: plain MLP)."""
+    init_alpha: float = 1.0
+    """Initial entropy temperature alpha."""
+    target_entropy: float | None = None
+    """Target entropy H_T; None means -dim(A)."""
+    log_std_min: float = -20.0
+    """Lower clamp of the actor's log standard deviation."""
+    log_std_max: float = 2.0
+    """Upper clamp of the actor's log standard deviation."""
+
+
+@dataclass
+class TrainConfig:
+    """The training loop: budget, warm-up, evaluation and checkpoint cadence."""
+
+    total_steps: int = 300_000
+    """Env steps to train for (``--steps`` overrides)."""
+    warmup_steps: int = 1000
+    """Random-action steps before learning starts (Table 1's 'learning starts')."""
+    buffer_size: int = 1_000_000
+    """Replay buffer capacity in transitions."""
+    updates_per_step: int = 1
+    """Gradient steps per env step after warm-up (UTD ratio)."""
+    eval_every: int = 10_000
+    """Env steps between periodic deterministic evaluations (0: never)."""
+    eval_episodes: int = 5
+    """Episodes per periodic evaluation."""
+    solved_episodes: int = 100
+    """Episodes of the full evaluation that decides 'solved'."""
+    solved_threshold: float = 300.0
+    """Mean return above which the environment counts as solved."""
+    checkpoint_every: int = 10_000
+    """Env steps between training-state checkpoints."""
+    threads: int = 0
+    """torch intra-op threads; 0 means all cores."""
+    eval_seed: int = 1_000_000
+    """First env seed of evaluation episodes (kept apart from training seeds)."""
+
+
+@dataclass
+class Config:
+    """Everything a run needs; one YAML file fills it."""
+
+    env: str = "BipedalWalker-v3"
+    """Gymnasium id (or alias walker / hardcore)."""
+    seed: int = 0
+    """Seeds networks, exploration, replay sampling and env resets."""
+    device: str = "auto"
+    """auto, cpu or cuda."""
+    agent: AgentConfig = field(default_factory=AgentConfig)
+    train: TrainConfig = field(default_factory=TrainConfig)
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+def _type_name(tp: Any) -> str:
+    if isinstance(tp, type):
+        return tp.__name__
+    return str(tp).replace("typing.", "")
+
+
+def _coerce(value: Any, tp: Any, key: str, source: str) -> Any:
+    """Check ``value`` against the annotated type ``tp``; ints are accepted for floats."""
+    origin = typing.get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        args = typing.get_args(tp)
+        if value is None and type(None) in args:
+            return None
+        for arg in args:
+            if arg is type(None):
+                continue
+            try:
+                return _coerce(value, arg, key, source)
+            except UserError:
+                pass
+        raise UserError(f"{source}: key {key!r} expects {_type_name(tp)}, got {value!r}")
+    if tp is bool:
+        if isinstance(value, bool):
+            return value
+    elif tp is int:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        if isinstance(value, float) and value.is_integer():
+            return int(value)
+    elif tp is float:
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            return float(value)
+    elif tp is str:
+        if isinstance(value, str):
+            return value
+    raise UserError(f"{source}: key {key!r} expects {_type_name(tp)}, got {value!r}")
+
+
+def _fill(obj: Any, data: dict[str, Any], prefix: str, source: str) -> None:
+    if not isinstance(data, dict):
+        raise UserError(
+            f"{source}: section {prefix.rstrip('.') or 'top level'!r} must be a mapping"
+        )
+    hints = typing.get_type_hints(type(obj))
+    names = {f.name for f in dataclasses.fields(obj)}
+    for key, value in data.items():
+        full = f"{prefix}{key}"
+        if key not in names:
+            raise UserError(f"{source}: unknown key {full!r}; expected one of {sorted(names)}")
+        current = getattr(obj, key)
+        if dataclasses.is_dataclass(current):
+            _fill(current, value, f"{full}.", source)
+        else:
+            setattr(obj, key, _coerce(value, hints[key], full, source))
+
+
+def config_from_dict(data: dict[str, Any], source: str = "config") -> Config:
+    cfg = Config()
+    _fill(cfg, data or {}, "", source)
+    cfg.env = canonical_env_id(cfg.env, f"{source}: key 'env'")
+    validate(cfg, source)
+    return cfg
+
+
+def load_yaml(path: str | Path) -> dict[str, Any]:
+    path = Path(path)
+    if not path.is_file():
+        raise UserError(f"--config {path}: no such file")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        line = getattr(getattr(exc, "problem_mark", None), "line", None)
+        where = f" (line {line + 1})" if line is not None else ""
+        raise UserError(
+            f"{path}: not valid YAML{where}; expected a mapping of config keys"
+        ) from None
+    except UnicodeDecodeError:
+        raise UserError(f"{path}: not a text file; expected a YAML config") from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise UserError(f"{path}: expected a mapping of config keys at the top level")
+    return data
+
+
+def parse_override(text: str) -> tuple[list[str], Any]:
+    """``'agent.lr=1e-3'`` -> ``(['agent', 'lr'], 0.001)``; values are parsed as YAML scalars."""
+    if "=" not in text:
+        raise UserError(f"--set {text!r}: expected key=value, e.g. agent.lr=0.0003")
+    key, raw = text.split("=", 1)
+    try:
+        value = yaml.safe_load(raw) if raw.strip() else None
+    except yaml.YAMLError:
+        value = raw
+    if isinstance(value, str) and _looks_numeric(value):
+        value = float(value)
+    return key.strip().split("."), value
+
+
+def _looks_numeric(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _set_nested(data: dict[str, Any], path: list[str], value: Any) -> None:
+    node = data
+    for part in path[:-1]:
+        node = node.setdefault(part, {})
+        if not isinstance(node, dict):
+            raise UserError(f"--set {'.'.join(path)}: {part!r} is not a section")
+    node[path[-1]] = value
+
+
+def resolve_config(
+    config_path: str | Path | None = None,
+    overrides: list[str] | None = None,
+    **explicit: Any,
+) -> Config:
+    """YAML file, then ``--set`` overrides, then explicit CLI options that are not None.
+
+    ``explicit`` maps dotted keys (``'train.total_steps'``) to values from dedicated options.
+    """
+    data: dict[str, Any] = load_yaml(config_path) if config_path else {}
+    source = str(config_path) if config_path else "config"
+    for text in overrides or []:
+        path, value = parse_override(text)
+        _set_nested(data, path, value)
+        source = f"{source} + --set" if "--set" not in source else source
+    for dotted, value in explicit.items():
+        if value is not None:
+            _set_nested(data, dotted.split("."), value)
+    return config_from_dict(data, source)
+
+
+def validate(cfg: Config, source: str) -> None:
+    a, t = cfg.agent, cfg.train
+    checks = [
+        (0.0 < a.gamma <= 1.0, "agent.gamma", "a number in (0, 1]"),
+        (a.lr > 0, "agent.lr", "a positive number"),
+        (a.batch_size >= 1, "agent.batch_size", "a positive integer"),
+        (0.0 < a.tau <= 1.0, "agent.tau", "a number in (0, 1]"),
+        (a.n_critics >= 1, "agent.n_critics", "a positive integer"),
+        (a.n_quantiles >= 1, "agent.n_quantiles", "a positive integer"),
+        (
+            0 <= a.drop_per_critic < a.n_quantiles,
+            "agent.drop_per_critic",
+            "an integer in [0, n_quantiles)",
+        ),
+        (a.actor_hidden >= 1 and a.critic_hidden >= 1, "agent.*_hidden", "positive widths"),
+        (a.n_layers >= 1, "agent.n_layers", "a positive integer"),
+        (a.init_alpha > 0, "agent.init_alpha", "a positive number"),
+        (t.total_steps >= 0, "train.total_steps", "a non-negative integer"),
+        (t.warmup_steps >= 0, "train.warmup_steps", "a non-negative integer"),
+        (t.buffer_size >= 1, "train.buffer_size", "a positive integer"),
+        (t.updates_per_step >= 0, "train.updates_per_step", "a non-negative integer"),
+        (t.eval_every >= 0, "train.eval_every", "a non-negative integer"),
+        (t.eval_episodes >= 1, "train.eval_episodes", "a positive integer"),
+        (t.solved_episodes >= 1, "train.solved_episodes", "a positive integer"),
+        (t.checkpoint_every >= 0, "train.checkpoint_every", "a non-negative integer"),
+        (t.threads >= 0, "train.threads", "a non-negative integer"),
+        (
+            cfg.device in ("auto", "cpu", "cuda") or cfg.device.startswith("cuda:"),
+            "device",
+            "auto, cpu or cuda",
+        ),
+    ]
+    for ok, key, expected in checks:
+        if not ok:
+            raise UserError(f"{source}: key {key!r} expects {expected}")

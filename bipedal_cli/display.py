@@ -1,0 +1,114 @@
+"""Rich rendering: the live training display and result tables (the CLI's view layer)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rich.console import Console, Group
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TaskProgressColumn,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+
+
+def _num(value: Any, fmt: str = "{:.1f}") -> str:
+    return "-" if value is None else fmt.format(value)
+
+
+class TrainingDisplay:
+    """A progress bar over env steps and a line of learning statistics under it."""
+
+    def __init__(self, console: Console | None = None, title: str = "training") -> None:
+        self.console = console or Console()
+        self.title = title
+        self.snapshot: dict[str, Any] = {}
+        outer = self
+
+        class _Progress(Progress):
+            def get_renderables(self):
+                yield Group(self.make_tasks_table(self.tasks), outer.stats_table())
+
+        self.progress = _Progress(
+            TextColumn("[bold]{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TaskProgressColumn(),
+            TimeElapsedColumn(),
+            TimeRemainingColumn(),
+            console=self.console,
+            refresh_per_second=4,
+        )
+        self.task = None
+
+    def stats_table(self) -> Table:
+        s = self.snapshot
+        table = Table.grid(padding=(0, 2))
+        for _ in range(4):
+            table.add_column(justify="right", style="cyan")
+            table.add_column(justify="left")
+        table.add_row(
+            "episodes",
+            _num(s.get("episodes"), "{:d}"),
+            "steps/s",
+            _num(s.get("steps_per_s")),
+            "return (last)",
+            _num(s.get("last_return")),
+            "return (avg 10)",
+            _num(s.get("avg_return")),
+        )
+        table.add_row(
+            "last eval",
+            _num(s.get("last_eval")),
+            "alpha",
+            _num(s.get("alpha"), "{:.4f}"),
+            "critic loss",
+            _num(s.get("critic_loss"), "{:.3f}"),
+            "actor loss",
+            _num(s.get("actor_loss"), "{:.2f}"),
+        )
+        return table
+
+    # Reporter protocol
+    def start(self, start_step: int, total_steps: int) -> None:
+        self.progress.start()
+        self.task = self.progress.add_task(self.title, total=total_steps, completed=start_step)
+
+    def update(self, snapshot: dict[str, Any]) -> None:
+        self.snapshot = snapshot
+        desc = f"{self.title} ({snapshot.get('phase', '')})"
+        self.progress.update(self.task, completed=snapshot["step"], description=desc)
+
+    def log(self, text: str) -> None:
+        self.progress.console.log(text)
+
+    def close(self) -> None:
+        self.progress.stop()
+
+
+def eval_table(summary: dict, title: str) -> Table:
+    table = Table(title=title, show_header=True, header_style="bold")
+    for col in ("episodes", "mean", "std", "min", "max", "median", "mean length", "falls"):
+        table.add_column(col, justify="right")
+    table.add_row(
+        str(summary["episodes"]),
+        f"{summary['mean']:.1f}",
+        f"{summary['std']:.1f}",
+        f"{summary['min']:.1f}",
+        f"{summary['max']:.1f}",
+        f"{summary['median']:.1f}",
+        f"{summary['mean_length']:.0f}",
+        str(summary["falls"]),
+    )
+    return table
+
+
+def verdict(summary: dict) -> str:
+    if summary["solved"]:
+        return f"[bold green]solved[/]: mean {summary['mean']:.1f} > {summary['threshold']:g}"
+    return f"[bold red]not solved[/]: mean {summary['mean']:.1f} <= {summary['threshold']:g}"

@@ -1,0 +1,152 @@
+"""The deterministic evaluation protocol: episodes with fixed env seeds, policy batched over them.
+
+"Solved" (the paper's criterion): the mean return of the deterministic policy tanh(mu(s)) over
+100 episodes exceeds 300. Episodes are split over worker processes, and inside a worker the
+policy runs on all of its episodes at once, one batched forward pass per env step.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import torch
+
+from .config import AgentConfig
+from .envs import is_fall, make_env
+
+
+@dataclass
+class EpisodeResult:
+    seed: int
+    ret: float
+    length: int
+    fell: bool
+
+
+def run_episodes(
+    policy: Callable[[np.ndarray], np.ndarray], env_id: str, seeds: list[int]
+) -> list[EpisodeResult]:
+    """Run one episode per seed in lockstep; ``policy`` maps (B, obs_dim) to (B, act_dim).
+
+    Each episode gets a new env: a reused Box2D world carries history across resets, and the
+    result of a seed should not depend on which episodes ran before it.
+    """
+    envs = [make_env(env_id) for _ in seeds]
+    obs = np.stack([env.reset(seed=int(s))[0] for env, s in zip(envs, seeds, strict=False)])
+    returns = np.zeros(len(seeds))
+    lengths = np.zeros(len(seeds), dtype=int)
+    fell = np.zeros(len(seeds), dtype=bool)
+    active = np.ones(len(seeds), dtype=bool)
+    while active.any():
+        idx = np.flatnonzero(active)
+        actions = policy(obs[idx].astype(np.float32))
+        for j, i in enumerate(idx):
+            o, r, term, trunc, _ = envs[i].step(actions[j])
+            obs[i] = o
+            returns[i] += r
+            lengths[i] += 1
+            if term or trunc:
+                active[i] = False
+                fell[i] = is_fall(term, r)
+    for env in envs:
+        env.close()
+    return [
+        EpisodeResult(int(s), float(r), int(n), bool(f))
+        for s, r, n, f in zip(seeds, returns, lengths, fell, strict=False)
+    ]
+
+
+def actor_policy(actor: torch.nn.Module, device: torch.device | str = "cpu"):
+    """Wrap an actor's deterministic action as a numpy batch policy."""
+
+    @torch.no_grad()
+    def policy(obs: np.ndarray) -> np.ndarray:
+        x = torch.as_tensor(obs, device=device)
+        return actor.deterministic(x).cpu().numpy()
+
+    return policy
+
+
+def _worker(
+    agent_cfg: dict, dims: tuple[int, int], actor_state: dict, env_id: str, seeds: list[int]
+) -> list[EpisodeResult]:
+    from .agent import make_actor
+
+    torch.set_num_threads(1)
+    actor = make_actor(AgentConfig(**agent_cfg), *dims)
+    actor.load_state_dict(actor_state)
+    actor.eval()
+    return run_episodes(actor_policy(actor), env_id, seeds)
+
+
+def evaluate_actor(
+    actor,
+    agent_cfg: AgentConfig,
+    env_id: str,
+    seeds: list[int],
+    workers: int = 0,
+    chunk: int = 5,
+    on_episodes: Callable[[int], None] | None = None,
+) -> list[EpisodeResult]:
+    """Evaluate ``actor`` (on CPU) on one episode per seed; ``workers=0`` uses every core.
+
+    ``on_episodes(n)`` is called as chunks of episodes finish (for progress bars).
+    """
+    workers = workers or min(os.cpu_count() or 1, max(1, len(seeds) // chunk))
+    state = {k: v.detach().cpu() for k, v in actor.state_dict().items()}
+    dims = (actor.obs_dim, actor.act_dim)
+    if workers <= 1:
+        cpu_actor = actor if next(actor.parameters()).device.type == "cpu" else None
+        if cpu_actor is None:
+            from .agent import make_actor
+
+            cpu_actor = make_actor(agent_cfg, *dims)
+            cpu_actor.load_state_dict(state)
+        results = []
+        threads = torch.get_num_threads()
+        torch.set_num_threads(1)  # batch-of-5 inference: more threads only contend
+        try:
+            for start in range(0, len(seeds), chunk):
+                part = run_episodes(actor_policy(cpu_actor), env_id, seeds[start : start + chunk])
+                results += part
+                if on_episodes:
+                    on_episodes(len(part))
+        finally:
+            torch.set_num_threads(threads)
+        return results
+    chunks = [seeds[i : i + chunk] for i in range(0, len(seeds), chunk)]
+    results_by_chunk: dict[int, list[EpisodeResult]] = {}
+    ctx = mp.get_context("spawn")  # fork after torch has started threads can hang
+    with ProcessPoolExecutor(workers, mp_context=ctx) as pool:
+        futures = {
+            pool.submit(_worker, asdict(agent_cfg), dims, state, env_id, c): i
+            for i, c in enumerate(chunks)
+        }
+        for fut in as_completed(futures):
+            part = fut.result()
+            results_by_chunk[futures[fut]] = part
+            if on_episodes:
+                on_episodes(len(part))
+    return [r for i in range(len(chunks)) for r in results_by_chunk[i]]
+
+
+def summarize(results: list[EpisodeResult], threshold: float = 300.0) -> dict:
+    returns = np.array([r.ret for r in results])
+    lengths = np.array([r.length for r in results])
+    return {
+        "episodes": len(results),
+        "mean": float(returns.mean()),
+        "std": float(returns.std()),
+        "min": float(returns.min()),
+        "max": float(returns.max()),
+        "median": float(np.median(returns)),
+        "mean_length": float(lengths.mean()),
+        "falls": int(sum(r.fell for r in results)),
+        "threshold": threshold,
+        "solved": bool(returns.mean() > threshold),
+    }

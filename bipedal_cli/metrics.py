@@ -1,0 +1,65 @@
+"""The run's metrics file: one CSV, a row per finished episode and per evaluation."""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import Any
+
+COLUMNS = [
+    "kind",  # episode | eval | full_eval
+    "stage",  # env id the row was produced on
+    "step",  # env steps so far
+    "episode",  # finished training episodes so far
+    "wall_time",  # seconds of training, summed over resumes
+    "return",  # episode return, or the mean return of an evaluation
+    "return_std",  # evaluation only
+    "length",  # episode length, or mean evaluation episode length
+    "fell",  # episode ended on the fall penalty (or number of evaluation falls)
+    "alpha",
+    "critic_loss",
+    "actor_loss",
+    "entropy",
+    "q_mean",
+]
+METRICS_FILE = "metrics.csv"
+
+
+class MetricsWriter:
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        if not self.path.exists():
+            with self.path.open("w", newline="") as f:
+                csv.writer(f).writerow(COLUMNS)
+
+    def write(self, row: dict[str, Any]) -> None:
+        unknown = set(row) - set(COLUMNS)
+        if unknown:
+            raise KeyError(f"unknown metric columns {sorted(unknown)}")
+        with self.path.open("a", newline="") as f:
+            csv.writer(f).writerow([_fmt(row.get(c, "")) for c in COLUMNS])
+
+    def truncate_after(self, step: int) -> None:
+        """Drop rows logged after ``step`` (written after the checkpoint a resume starts from)."""
+        rows = read_metrics(self.path)
+        kept = [r for r in rows if int(float(r["step"])) <= step]
+        tmp = self.path.with_suffix(".csv.tmp")
+        with tmp.open("w", newline="") as f:
+            w = csv.DictWriter(f, COLUMNS)
+            w.writeheader()
+            w.writerows(kept)
+        tmp.replace(self.path)
+
+
+def _fmt(value: Any) -> Any:
+    if isinstance(value, float):
+        return "" if math.isnan(value) else f"{value:.6g}"
+    if isinstance(value, bool):
+        return int(value)
+    return value
+
+
+def read_metrics(path: str | Path) -> list[dict[str, str]]:
+    with Path(path).open(newline="") as f:
+        return list(csv.DictReader(f))

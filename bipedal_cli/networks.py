@@ -1,0 +1,171 @@
+"""D2RL networks: a dense MLP ensemble, the squashed-Gaussian actor and the quantile critics.
+
+D2RL (Sinha et al. 2020) concatenates the network input x to the output of every hidden layer
+except the last::
+
+    h_1 = relu(W_1 x + b_1)
+    h_l = relu(W_l [h_{l-1}, x] + b_l)        l = 2..L
+    out = W_o h_L + b_o
+
+``W_l [h, x]`` equals ``W_l^h h + W_l^x x``, so the x-parts of every layer of every ensemble
+member are computed by one matrix product up front, and each member's hidden layers are batched
+matrix products over the ensemble dimension: N critics cost one call per layer, not N.
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch
+from torch import nn
+from torch.nn import functional as F
+
+
+class DenseEnsemble(nn.Module):
+    """``ensemble`` independent (D2RL or plain) MLPs that share their input.
+
+    Initialisation matches ``nn.Linear``: U(-1/sqrt(fan_in), 1/sqrt(fan_in)) per member, with
+    fan_in = H + in_dim for the layers that see the concatenated input.
+    """
+
+    def __init__(
+        self,
+        in_dim: int,
+        out_dim: int,
+        hidden: int,
+        n_layers: int,
+        ensemble: int = 1,
+        d2rl: bool = True,
+    ) -> None:
+        super().__init__()
+        self.in_dim, self.out_dim, self.hidden = in_dim, out_dim, hidden
+        self.n_layers, self.ensemble, self.d2rl = n_layers, ensemble, d2rl
+        n_proj = n_layers if d2rl else 1  # layers that read x directly
+        self.n_proj = n_proj
+        E, H = ensemble, hidden
+        # x-part of every layer that reads the input, all members at once: (in, E * n_proj * H)
+        self.w_in = nn.Parameter(torch.empty(in_dim, E * n_proj * H))
+        self.b_in = nn.Parameter(torch.empty(n_layers, E, 1, H))  # biases of all hidden layers
+        self.w_hidden = nn.Parameter(torch.empty(n_layers - 1, E, H, H))  # h-part of layers 2..L
+        self.w_out = nn.Parameter(torch.empty(E, H, out_dim))
+        self.b_out = nn.Parameter(torch.empty(E, 1, out_dim))
+        self.reset_parameters()
+
+    def _fan_in(self, layer: int) -> int:
+        if layer == 0:
+            return self.in_dim
+        return self.hidden + (self.in_dim if self.d2rl else 0)
+
+    @torch.no_grad()
+    def reset_parameters(self) -> None:
+        E, H, P = self.ensemble, self.hidden, self.n_proj
+        w_in = self.w_in.view(self.in_dim, E, P, H)
+        for layer in range(self.n_layers):
+            bound = 1.0 / math.sqrt(self._fan_in(layer))
+            if layer < P:
+                w_in[:, :, layer].uniform_(-bound, bound)
+            self.b_in[layer].uniform_(-bound, bound)
+            if layer > 0:
+                self.w_hidden[layer - 1].uniform_(-bound, bound)
+        bound = 1.0 / math.sqrt(H)
+        self.w_out.uniform_(-bound, bound)
+        self.b_out.uniform_(-bound, bound)
+
+    def forward(self, x: torch.Tensor, detach_params: bool = False) -> torch.Tensor:
+        """x: (B, in_dim) -> (B, ensemble, out_dim).
+
+        ``detach_params`` runs the same function with the parameters cut from autograd: the actor
+        loss needs dQ/da through the critics but no gradient for the critics' weights, and this
+        skips computing them.
+        """
+        params = [self.w_in, self.b_in, self.w_hidden, self.w_out, self.b_out]
+        if detach_params:
+            params = [p.detach() for p in params]
+        w_in, b_in, w_hidden, w_out, b_out = params
+        B, E, H, P = x.shape[0], self.ensemble, self.hidden, self.n_proj
+        proj = (x @ w_in).view(B, E, P, H).permute(2, 1, 0, 3)  # (P, E, B, H)
+        h = F.relu(proj[0] + b_in[0])  # (E, B, H)
+        for layer in range(1, self.n_layers):
+            pre = b_in[layer] + proj[layer] if self.d2rl else b_in[layer].expand(E, B, H)
+            h = F.relu(torch.baddbmm(pre, h, w_hidden[layer - 1]))  # (E, B, H)
+        out = torch.baddbmm(b_out, h, w_out)  # (E, B, out_dim)
+        return out.transpose(0, 1)  # (B, E, out_dim)
+
+
+class SquashedGaussianActor(nn.Module):
+    """pi(a|s): u ~ N(mu(s), sigma(s)^2), a = tanh(u); deterministic action tanh(mu(s))."""
+
+    def __init__(
+        self,
+        obs_dim: int,
+        act_dim: int,
+        hidden: int = 512,
+        n_layers: int = 2,
+        d2rl: bool = True,
+        log_std_min: float = -20.0,
+        log_std_max: float = 2.0,
+    ) -> None:
+        super().__init__()
+        self.obs_dim, self.act_dim = obs_dim, act_dim
+        self.net = DenseEnsemble(obs_dim, 2 * act_dim, hidden, n_layers, 1, d2rl)
+        self.log_std_min, self.log_std_max = log_std_min, log_std_max
+
+    def distribution_params(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """obs: (B, obs_dim) -> mean, log_std: (B, act_dim) each, log_std clamped."""
+        out = self.net(obs)[:, 0]  # (B, 2 * act_dim)
+        mean, log_std = out.chunk(2, dim=-1)
+        return mean, log_std.clamp(self.log_std_min, self.log_std_max)
+
+    def deterministic(self, obs: torch.Tensor) -> torch.Tensor:
+        """The evaluation policy: tanh of the Gaussian's mean, (B, act_dim)."""
+        mean, _ = self.distribution_params(obs)
+        return torch.tanh(mean)
+
+    def forward(self, obs: torch.Tensor) -> torch.Tensor:
+        return self.deterministic(obs)
+
+    def sample(
+        self, obs: torch.Tensor, generator: torch.Generator | None = None
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """Reparameterised sample a = tanh(mu + sigma * eps) and log pi(a|s), (B, A) and (B,)."""
+        mean, log_std = self.distribution_params(obs)
+        eps = torch.randn(mean.shape, generator=generator, device=mean.device, dtype=mean.dtype)
+        u = mean + log_std.exp() * eps
+        return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std)
+
+
+def squashed_gaussian_log_prob(
+    u: torch.Tensor, eps: torch.Tensor, log_std: torch.Tensor
+) -> torch.Tensor:
+    """log pi(tanh(u)) = sum_j [log N(u_j; mu_j, sigma_j) - log(1 - tanh(u_j)^2)], shape (B,).
+
+    With u = mu + sigma * eps, log N(u; mu, sigma) = -eps^2/2 - log sigma - log(2 pi)/2, and
+    log(1 - tanh(u)^2) = 2 (log 2 - u - softplus(-2u)) stays finite where tanh(u) rounds to +-1.
+    """
+    gaussian = -0.5 * eps.pow(2) - log_std - 0.5 * math.log(2 * math.pi)
+    log_det = 2.0 * (math.log(2.0) - u - F.softplus(-2.0 * u))
+    return (gaussian - log_det).sum(dim=-1)
+
+
+class QuantileCritics(nn.Module):
+    """N distributional critics Z_psi_n(s, a), each M quantile atoms: output (B, N, M)."""
+
+    def __init__(
+        self,
+        obs_dim: int,
+        act_dim: int,
+        hidden: int = 256,
+        n_layers: int = 2,
+        n_critics: int = 5,
+        n_quantiles: int = 25,
+        d2rl: bool = True,
+    ) -> None:
+        super().__init__()
+        self.n_critics, self.n_quantiles = n_critics, n_quantiles
+        self.net = DenseEnsemble(obs_dim + act_dim, n_quantiles, hidden, n_layers, n_critics, d2rl)
+
+    def forward(
+        self, obs: torch.Tensor, act: torch.Tensor, detach_params: bool = False
+    ) -> torch.Tensor:
+        """obs: (B, obs_dim), act: (B, act_dim) -> atoms theta: (B, N, M)."""
+        return self.net(torch.cat([obs, act], dim=-1), detach_params=detach_params)

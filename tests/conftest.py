@@ -1,0 +1,37 @@
+import pytest
+
+from bipedal_cli.config import Config, config_from_dict
+
+TINY = {
+    "seed": 3,
+    "device": "cpu",
+    "agent": {
+        "batch_size": 16,
+        "n_critics": 2,
+        "n_quantiles": 5,
+        "drop_per_critic": 1,
+        "actor_hidden": 16,
+        "critic_hidden": 16,
+    },
+    "train": {
+        "total_steps": 400,
+        "warmup_steps": 100,
+        "buffer_size": 250,  # smaller than the run: the ring buffer wraps
+        "eval_every": 0,
+        "eval_episodes": 2,
+        "solved_episodes": 2,
+        "checkpoint_every": 0,
+        "threads": 1,
+    },
+}
+
+
+def tiny_dict(**train) -> dict:
+    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in TINY.items()}
+    data["train"].update(train)
+    return data
+
+
+@pytest.fixture
+def tiny_config() -> Config:
+    return config_from_dict(tiny_dict())

@@ -1,0 +1,110 @@
+import csv
+
+import numpy as np
+import pytest
+import torch
+
+from bipedal_cli.checkpoint import load_checkpoint
+from bipedal_cli.config import config_from_dict
+from bipedal_cli.train import resume, train
+
+from .conftest import tiny_dict
+
+
+def flat_state(obj):
+    """Every tensor/array in a nested state dict, keyed by path (RNG states included)."""
+    out = {}
+
+    def walk(prefix, value):
+        if isinstance(value, dict):
+            for k, v in value.items():
+                walk(f"{prefix}/{k}", v)
+        elif isinstance(value, (list, tuple)):
+            for i, v in enumerate(value):
+                walk(f"{prefix}/{i}", v)
+        else:
+            out[prefix] = value
+
+    walk("", obj)
+    return out
+
+
+def assert_states_equal(a: dict, b: dict, skip=("/counters/wall_time",)):
+    fa, fb = flat_state(a), flat_state(b)
+    assert fa.keys() == fb.keys()
+    for key in fa:
+        if key in skip or key.startswith(("/last_eval", "/full_eval")):
+            continue
+        va, vb = fa[key], fb[key]
+        if torch.is_tensor(va):
+            assert torch.equal(va, vb), key
+        elif isinstance(va, np.ndarray):
+            assert np.array_equal(va, vb), key
+        else:
+            assert va == vb, key
+
+
+def test_resume_matches_uninterrupted_run(tmp_path):
+    straight = train(config_from_dict(tiny_dict(total_steps=400)), tmp_path / "straight")
+    first = train(config_from_dict(tiny_dict(total_steps=230)), tmp_path / "split")
+    assert first.steps == 230
+    second = resume(tmp_path / "split", total_steps=400)
+    assert straight.steps == second.steps == 400
+    assert straight.episodes == second.episodes
+    a = load_checkpoint(tmp_path / "straight" / "state.pt")
+    b = load_checkpoint(tmp_path / "split" / "state.pt")
+    assert a["agent"]["updates"] == 300
+    assert_states_equal(
+        {k: v for k, v in a.items() if k != "path"}, {k: v for k, v in b.items() if k != "path"}
+    )
+    # The metrics files tell the same story (wall times aside).
+    rows = []
+    for name in ("straight", "split"):
+        with open(tmp_path / name / "metrics.csv") as f:
+            rows.append([(r["step"], r["return"], r["critic_loss"]) for r in csv.DictReader(f)])
+    assert rows[0] == rows[1] and len(rows[0]) >= 2
+
+
+def test_same_seed_same_result_and_other_seed_differs(tmp_path):
+    a = train(config_from_dict(tiny_dict(total_steps=150)), tmp_path / "a")
+    b = train(config_from_dict(tiny_dict(total_steps=150)), tmp_path / "b")
+    c_cfg = tiny_dict(total_steps=150)
+    c_cfg["seed"] = 4
+    c = train(config_from_dict(c_cfg), tmp_path / "c")
+    pa, pb, pc = (load_checkpoint(r.run_dir / "policy.pt")["actor"] for r in (a, b, c))
+    assert all(torch.equal(pa[k], pb[k]) for k in pa)
+    assert not all(torch.equal(pa[k], pc[k]) for k in pa)
+
+
+def test_periodic_eval_and_metrics_written(tmp_path):
+    result = train(
+        config_from_dict(tiny_dict(total_steps=200, eval_every=100, checkpoint_every=100)),
+        tmp_path / "run",
+    )
+    with open(tmp_path / "run" / "metrics.csv") as f:
+        rows = list(csv.DictReader(f))
+    evals = [r for r in rows if r["kind"] == "eval"]
+    assert [int(r["step"]) for r in evals] == [100, 200]
+    assert result.last_eval["episodes"] == 2 and result.last_eval["step"] == 200
+    episodes = [r for r in rows if r["kind"] == "episode"]
+    assert len(episodes) == result.episodes
+    assert all(r["stage"] == "BipedalWalker-v3" for r in rows)
+    meta = load_checkpoint(tmp_path / "run" / "policy.pt")["meta"]
+    assert meta["steps"] == 200 and meta["episodes"] == result.episodes
+
+
+def test_until_solved_runs_full_evaluation_when_threshold_crossed(tmp_path):
+    # A threshold of -1000 is crossed at the first evaluation: the full test runs and stops.
+    data = tiny_dict(total_steps=400, eval_every=100)
+    data["train"]["solved_threshold"] = -1000.0
+    result = train(config_from_dict(data), tmp_path / "run", until_solved=True)
+    assert result.stopped == "solved" and result.steps == 100
+    assert result.full_eval["episodes"] == 2 and result.full_eval["solved"]
+
+
+def test_new_run_refuses_an_existing_run_dir(tmp_path):
+    from bipedal_cli.errors import UserError
+
+    train(config_from_dict(tiny_dict(total_steps=20)), tmp_path / "run")
+    with pytest.raises(UserError, match="already holds a run"):
+        train(config_from_dict(tiny_dict(total_steps=20)), tmp_path / "run")
