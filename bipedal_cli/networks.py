@@ -24,6 +24,10 @@ from torch.nn import functional as F
 class DenseEnsemble(nn.Module):
     """``ensemble`` independent (D2RL or plain) MLPs that share their input.
 
+    Parameters, per layer l (E members, H hidden, P layers that read x: L with D2RL, else 1):
+    ``w_x[l]`` (in_dim, E*H) the x-part, ``w_h[l-1]`` (E, H, H) the h-part, ``b[l]`` (E, 1, H);
+    ``w_out`` (E, H, out_dim), ``b_out`` (E, 1, out_dim). Separate tensors per layer: slicing one
+    packed tensor would cost a zero-fill and a copy of its gradient in every backward pass.
     Initialisation matches ``nn.Linear``: U(-1/sqrt(fan_in), 1/sqrt(fan_in)) per member, with
     fan_in = H + in_dim for the layers that see the concatenated input.
     """
@@ -40,13 +44,15 @@ class DenseEnsemble(nn.Module):
         super().__init__()
         self.in_dim, self.out_dim, self.hidden = in_dim, out_dim, hidden
         self.n_layers, self.ensemble, self.d2rl = n_layers, ensemble, d2rl
-        n_proj = n_layers if d2rl else 1  # layers that read x directly
-        self.n_proj = n_proj
         E, H = ensemble, hidden
-        # x-part of every layer that reads the input, all members at once: (in, E * n_proj * H)
-        self.w_in = nn.Parameter(torch.empty(in_dim, E * n_proj * H))
-        self.b_in = nn.Parameter(torch.empty(n_layers, E, 1, H))  # biases of all hidden layers
-        self.w_hidden = nn.Parameter(torch.empty(n_layers - 1, E, H, H))  # h-part of layers 2..L
+        n_proj = n_layers if d2rl else 1  # layers that read x directly
+        self.w_x = nn.ParameterList(
+            [nn.Parameter(torch.empty(in_dim, E * H)) for _ in range(n_proj)]
+        )
+        self.w_h = nn.ParameterList(
+            [nn.Parameter(torch.empty(E, H, H)) for _ in range(n_layers - 1)]
+        )
+        self.b = nn.ParameterList([nn.Parameter(torch.empty(E, 1, H)) for _ in range(n_layers)])
         self.w_out = nn.Parameter(torch.empty(E, H, out_dim))
         self.b_out = nn.Parameter(torch.empty(E, 1, out_dim))
         self.reset_parameters()
@@ -58,16 +64,14 @@ class DenseEnsemble(nn.Module):
 
     @torch.no_grad()
     def reset_parameters(self) -> None:
-        E, H, P = self.ensemble, self.hidden, self.n_proj
-        w_in = self.w_in.view(self.in_dim, E, P, H)
         for layer in range(self.n_layers):
             bound = 1.0 / math.sqrt(self._fan_in(layer))
-            if layer < P:
-                w_in[:, :, layer].uniform_(-bound, bound)
-            self.b_in[layer].uniform_(-bound, bound)
+            if layer < len(self.w_x):
+                self.w_x[layer].uniform_(-bound, bound)
             if layer > 0:
-                self.w_hidden[layer - 1].uniform_(-bound, bound)
-        bound = 1.0 / math.sqrt(H)
+                self.w_h[layer - 1].uniform_(-bound, bound)
+            self.b[layer].uniform_(-bound, bound)
+        bound = 1.0 / math.sqrt(self.hidden)
         self.w_out.uniform_(-bound, bound)
         self.b_out.uniform_(-bound, bound)
 
@@ -78,17 +82,21 @@ class DenseEnsemble(nn.Module):
         loss needs dQ/da through the critics but no gradient for the critics' weights, and this
         skips computing them.
         """
-        params = [self.w_in, self.b_in, self.w_hidden, self.w_out, self.b_out]
-        if detach_params:
-            params = [p.detach() for p in params]
-        w_in, b_in, w_hidden, w_out, b_out = params
-        B, E, H, P = x.shape[0], self.ensemble, self.hidden, self.n_proj
-        proj = (x @ w_in).view(B, E, P, H).permute(2, 1, 0, 3)  # (P, E, B, H)
-        h = F.relu(proj[0] + b_in[0])  # (E, B, H)
+
+        def p(t: torch.Tensor) -> torch.Tensor:
+            return t.detach() if detach_params else t
+
+        B, E, H = x.shape[0], self.ensemble, self.hidden
+
+        def x_part(layer: int) -> torch.Tensor:  # W_l^x x for every member: (E, B, H)
+            return (x @ p(self.w_x[layer])).view(B, E, H).transpose(0, 1)
+
+        h = F.relu(x_part(0) + p(self.b[0]))  # (E, B, H)
         for layer in range(1, self.n_layers):
-            pre = b_in[layer] + proj[layer] if self.d2rl else b_in[layer].expand(E, B, H)
-            h = F.relu(torch.baddbmm(pre, h, w_hidden[layer - 1]))  # (E, B, H)
-        out = torch.baddbmm(b_out, h, w_out)  # (E, B, out_dim)
+            bias = p(self.b[layer])
+            pre = bias + x_part(layer) if self.d2rl else bias.expand(E, B, H)
+            h = F.relu(torch.baddbmm(pre, h, p(self.w_h[layer - 1])))  # (E, B, H)
+        out = torch.baddbmm(p(self.b_out), h, p(self.w_out))  # (E, B, out_dim)
         return out.transpose(0, 1)  # (B, E, out_dim)
 
 

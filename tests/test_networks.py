@@ -7,16 +7,16 @@ from bipedal_cli.networks import DenseEnsemble, QuantileCritics, SquashedGaussia
 
 def explicit_d2rl(net: DenseEnsemble, x: torch.Tensor, member: int) -> torch.Tensor:
     """The D2RL MLP of one member written with torch.cat, as in the D2RL paper's code."""
-    E, H, P, L = net.ensemble, net.hidden, net.n_proj, net.n_layers
-    w_in = net.w_in.view(net.in_dim, E, P, H)[:, member]  # (in, P, H)
-    h = torch.relu(x @ w_in[:, 0] + net.b_in[0, member, 0])
+    E, H, L = net.ensemble, net.hidden, net.n_layers
+    w_x = [w.view(net.in_dim, E, H)[:, member] for w in net.w_x]  # (in, H) each
+    h = torch.relu(x @ w_x[0] + net.b[0][member, 0])
     for layer in range(1, L):
-        w_h = net.w_hidden[layer - 1, member]
+        w_h = net.w_h[layer - 1][member]
         if net.d2rl:
-            w = torch.cat([w_h, w_in[:, layer]], dim=0)  # rows for [h, x]
-            h = torch.relu(torch.cat([h, x], dim=1) @ w + net.b_in[layer, member, 0])
+            w = torch.cat([w_h, w_x[layer]], dim=0)  # rows for [h, x]
+            h = torch.relu(torch.cat([h, x], dim=1) @ w + net.b[layer][member, 0])
         else:
-            h = torch.relu(h @ w_h + net.b_in[layer, member, 0])
+            h = torch.relu(h @ w_h + net.b[layer][member, 0])
     return h @ net.w_out[member] + net.b_out[member, 0]
 
 
@@ -37,7 +37,7 @@ def test_d2rl_input_reaches_every_hidden_layer():
     for d2rl in (True, False):
         net = DenseEnsemble(4, 1, 8, 3, ensemble=1, d2rl=d2rl)
         with torch.no_grad():
-            net.b_in[0].fill_(-1e3)  # layer 1 outputs zeros: only the dense links carry x on
+            net.b[0].fill_(-1e3)  # layer 1 outputs zeros: only the dense links carry x on
         x = torch.randn(6, 4, requires_grad=True)
         net(x).sum().backward()
         if d2rl:
@@ -48,8 +48,10 @@ def test_d2rl_input_reaches_every_hidden_layer():
 
 def test_init_matches_nn_linear_bounds():
     net = DenseEnsemble(24, 8, 512, 2, ensemble=1, d2rl=True)
-    assert net.w_in.abs().max() <= 1 / math.sqrt(24) + 1e-7
-    assert net.w_hidden.abs().max() <= 1 / math.sqrt(512 + 24) + 1e-7
+    assert net.w_x[0].abs().max() <= 1 / math.sqrt(24) + 1e-7
+    assert net.w_x[1].abs().max() <= 1 / math.sqrt(512 + 24) + 1e-7
+    assert net.w_x[1].abs().max() > 0.9 / math.sqrt(512 + 24)
+    assert net.w_h[0].abs().max() <= 1 / math.sqrt(512 + 24) + 1e-7
     assert net.w_out.abs().max() <= 1 / math.sqrt(512) + 1e-7
 
 
