@@ -9,13 +9,13 @@ kill at any moment leaves the previous checkpoint intact.
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import torch
 
 from .errors import UserError
+from .paths import atomic_path
 
 FORMAT_VERSION = 1
 TRAIN_FORMAT = "bipedal-train-state"
@@ -25,21 +25,13 @@ POLICY_FILE = "policy.pt"
 
 
 def atomic_save(obj: Any, path: str | Path) -> None:
-    """torch.save to ``path`` through a temporary file and ``os.replace``."""
+    """torch.save to ``path`` through a temporary file, fsync and ``os.replace``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        os.chmod(tmp, 0o644)  # mkstemp makes it owner-only; a checkpoint is a normal file
-        with os.fdopen(fd, "wb") as f:
-            torch.save(obj, f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        torch.save(obj, f)
+        f.flush()
+        os.fsync(f.fileno())
 
 
 def load_checkpoint(path: str | Path, option: str = "CKPT") -> dict[str, Any]:
@@ -116,14 +108,5 @@ def check_dims(data: dict[str, Any], obs_dim: int, act_dim: int, env_id: str, op
 
 def atomic_write_text(path: str | Path, text: str) -> None:
     """Write a text file (JSON reports) through a temporary file and ``os.replace``."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
-    try:
-        os.chmod(tmp, 0o644)
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(text)

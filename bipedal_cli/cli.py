@@ -17,6 +17,7 @@ from rich.console import Console
 
 from .config import canonical_env_id, resolve_config
 from .errors import UserError
+from .paths import check_output_path
 
 app = typer.Typer(
     add_completion=False,
@@ -133,7 +134,10 @@ def resume(
     if device:
         resolve_device(device)
     result = resume_run(run, steps, TrainingDisplay(console, "resume"), until_solved, device)
-    _report_result(result)
+    if hasattr(result, "stages"):
+        _report_curriculum(result)
+    else:
+        _report_result(result)
 
 
 @app.command("eval")
@@ -152,9 +156,7 @@ def eval_(
     """Evaluate the deterministic policy tanh(mean) on fixed env seeds (solved: mean > 300)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
-    from .checkpoint import actor_from_checkpoint, check_dims, load_checkpoint
     from .display import eval_table, verdict
-    from .envs import env_dims, make_env
     from .evaluation import evaluate_actor, summarize
 
     if episodes < 1:
@@ -162,13 +164,8 @@ def eval_(
     if workers < 0:
         raise UserError("--workers: expected 0 (every core) or a positive integer")
     if json_out is not None:
-        _check_writable(json_out, "--json")
-    data = load_checkpoint(ckpt)
-    actor, cfg = actor_from_checkpoint(data)
-    env_id = canonical_env_id(env) if env else data["env"]
-    probe = make_env(env_id)
-    check_dims(data, *env_dims(probe), env_id)
-    probe.close()
+        check_output_path(json_out, "--json")
+    data, actor, cfg, env_id = _load_policy(ckpt, env)
     seeds = list(range(seed, seed + episodes))
     started = time.perf_counter()
     with Progress(
@@ -200,12 +197,232 @@ def eval_(
         console.print(f"wrote {json_out}")
 
 
-def _check_writable(path: Path, option: str) -> None:
-    parent = path.parent if str(path.parent) else Path(".")
-    if path.is_dir():
-        raise UserError(f"{option} {path}: is a directory; expected a file path")
-    if not parent.is_dir():
-        raise UserError(f"{option} {path}: directory {parent} does not exist")
+def _load_policy(ckpt: Path, env: str | None):
+    """(checkpoint data, actor, config, env id) with the dims checked against the env."""
+    from .checkpoint import actor_from_checkpoint, check_dims, load_checkpoint
+    from .envs import env_dims, make_env
+
+    data = load_checkpoint(ckpt)
+    actor, cfg = actor_from_checkpoint(data)
+    env_id = canonical_env_id(env) if env else data["env"]
+    probe = make_env(env_id)
+    check_dims(data, *env_dims(probe), env_id)
+    probe.close()
+    return data, actor, cfg, env_id
+
+
+@app.command()
+def record(
+    ckpt: Annotated[
+        Path, typer.Argument(metavar="CKPT", help="policy.pt, state.pt or a run directory.")
+    ],
+    out: Annotated[Path, typer.Option("--out", help="Output .mp4 (H.264) or .gif.")] = Path(
+        "bipedal.mp4"
+    ),
+    episodes: Annotated[int, typer.Option("--episodes", help="Episodes to record.")] = 1,
+    seed: Annotated[int, typer.Option("--seed", help="Episode i uses env seed S + i.")] = 0,
+    env: EnvOpt = None,
+    fps: Annotated[
+        float | None, typer.Option("--fps", help="Frame rate (default: the env's, 50).")
+    ] = None,
+    frame_step: Annotated[
+        int | None, typer.Option("--frame-step", help="Keep every n-th frame (GIF default 2).")
+    ] = None,
+    scale: Annotated[
+        float | None, typer.Option("--scale", help="Resize frames (GIF default 0.5).")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+) -> None:
+    """Record the deterministic policy off-screen (no display needed) to MP4 or GIF."""
+    from rich.progress import BarColumn, Progress, TimeElapsedColumn
+
+    from .evaluation import actor_policy
+    from .video import VIDEO_SUFFIXES
+    from .video import record as record_video
+
+    check_output_path(out, "--out", VIDEO_SUFFIXES, force)
+    if episodes < 1:
+        raise UserError("--episodes: expected a positive integer")
+    if fps is not None and fps <= 0:
+        raise UserError("--fps: expected a positive number")
+    gif = out.suffix.lower() == ".gif"
+    frame_step = frame_step or (2 if gif else 1)
+    scale = scale or (0.5 if gif else 1.0)
+    if frame_step < 1 or not 0 < scale <= 4:
+        raise UserError("--frame-step/--scale: expected a positive step and a scale in (0, 4]")
+    data, actor, cfg, env_id = _load_policy(ckpt, env)
+    from .envs import make_env
+
+    max_steps = make_env(env_id).spec.max_episode_steps or 2000
+    seeds = list(range(seed, seed + episodes))
+    with Progress(
+        "[bold]rendering",
+        BarColumn(),
+        "{task.completed} frames",
+        TimeElapsedColumn(),
+        console=console,
+    ) as progress:
+        task = progress.add_task("render", total=episodes * (max_steps + 1))
+        recorded, frames, rate = record_video(
+            actor_policy(actor),
+            env_id,
+            out,
+            seeds,
+            fps,
+            frame_step,
+            scale,
+            on_frame=lambda: progress.advance(task),
+        )
+        progress.update(task, total=progress.tasks[0].completed)
+    for ep in recorded:
+        fell = "  (fell)" if ep.fell else ""
+        console.print(f"episode seed {ep.seed}: return {ep.ret:.1f}, {ep.length} steps{fell}")
+    console.print(f"wrote {out}: {frames} frames, {frames / rate:.1f} s at {rate:g} fps")
+
+
+@app.command()
+def curriculum(
+    config: Annotated[
+        Path | None,
+        typer.Option("--config", help="YAML config (default configs/curriculum.yaml values)."),
+    ] = None,
+    set_: Annotated[list[str] | None, typer.Option("--set", help="Override a config key.")] = None,
+    walker_steps: Annotated[
+        int | None, typer.Option("--walker-steps", help="Stage 1 budget (BipedalWalker-v3).")
+    ] = None,
+    hardcore_steps: Annotated[
+        int | None, typer.Option("--hardcore-steps", help="Stage 2 budget (Hardcore).")
+    ] = None,
+    replay: Annotated[
+        str | None, typer.Option("--replay", help="keep | clear the buffer at the switch.")
+    ] = None,
+    seed: Annotated[int | None, typer.Option("--seed")] = None,
+    run_dir: Annotated[Path | None, typer.Option("--run-dir")] = None,
+    device: DeviceOpt = None,
+) -> None:
+    """Walker until solved (or its budget), then Hardcore with the same agent."""
+    from .curriculum import start_curriculum
+    from .display import TrainingDisplay
+
+    cfg = resolve_config(
+        config,
+        set_,
+        **{
+            "seed": seed,
+            "device": device,
+            "curriculum.walker_steps": walker_steps,
+            "curriculum.hardcore_steps": hardcore_steps,
+            "curriculum.replay": replay,
+        },
+    )
+    result = start_curriculum(cfg, run_dir, TrainingDisplay(console, "curriculum"))
+    _report_curriculum(result)
+
+
+def _report_curriculum(result) -> None:
+    from rich.table import Table
+
+    table = Table(title=f"curriculum ({result.stopped}): {result.run_dir}")
+    for col in ("stage", "env", "steps", "episodes", "wall time", "evaluation", "result"):
+        table.add_column(col, justify="right")
+    for i, st in enumerate(result.stages, 1):
+        ev = st["full_eval"] or st["last_eval"]
+        ev_text = f"{ev['mean']:.1f} +- {ev['std']:.1f} ({ev['episodes']} ep.)" if ev else "-"
+        table.add_row(
+            str(i),
+            st["env"],
+            f"{st['steps']:,}",
+            f"{st['episodes']:,}",
+            f"{st['wall_time'] / 60:.1f} min",
+            ev_text,
+            st["stopped"],
+        )
+    console.print(table)
+    console.print(f"resume: bipedal resume {result.run_dir}")
+
+
+@app.command()
+def plot(
+    runs: Annotated[list[Path], typer.Argument(metavar="RUN_DIR...", help="Run directories.")],
+    out: Annotated[Path, typer.Option("--out", help="Output .png or .svg.")] = Path("curve.png"),
+    label: Annotated[
+        list[str] | None, typer.Option("--label", help="Legend label per run (repeat).")
+    ] = None,
+    aggregate: Annotated[
+        bool, typer.Option("--aggregate", help="Average runs that share a label (seeds).")
+    ] = False,
+    title: Annotated[str | None, typer.Option("--title")] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+) -> None:
+    """Learning curves: 10-episode moving mean with a +-1 std band, evaluations, the 300 line."""
+    from .plotting import PLOT_SUFFIXES, plot_runs
+
+    check_output_path(out, "--out", PLOT_SUFFIXES, force)
+    plot_runs(runs, out, label, aggregate, title)
+    console.print(f"wrote {out}")
+
+
+@app.command()
+def export(
+    ckpt: Annotated[Path, typer.Argument(metavar="CKPT")],
+    out: Annotated[Path, typer.Option("--out", help="Output .pt2 (torch.export).")] = Path(
+        "policy.pt2"
+    ),
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+) -> None:
+    """Export the deterministic policy for use with torch alone: torch.export.load(out).module()."""
+    from .export import EXPORT_SUFFIXES, export_policy
+
+    check_output_path(out, "--out", EXPORT_SUFFIXES, force)
+    data, actor, _, _ = _load_policy(ckpt, None)
+    export_policy(actor, out)
+    console.print(
+        f"wrote {out}: torch.export program, obs (B, {data['obs_dim']}) -> actions "
+        f"(B, {data['act_dim']}); load with torch.export.load({str(out)!r}).module()"
+    )
+
+
+@app.command()
+def info(ckpt: Annotated[Path, typer.Argument(metavar="CKPT")]) -> None:
+    """What a checkpoint holds: env, steps, episodes, config, evaluations, format version."""
+    from rich.table import Table
+
+    from .checkpoint import TRAIN_FORMAT, load_checkpoint
+
+    data = load_checkpoint(ckpt)
+    if data["format"] == TRAIN_FORMAT:
+        c = data["counters"]
+        meta = {
+            "steps": c["step"],
+            "episodes": c["episodes"],
+            "wall_time": round(c["wall_time"], 1),
+            "last_eval": data["last_eval"],
+            "full_eval": data["full_eval"],
+            "replay buffer": f"{int(data['buffer']['size']):,} transitions",
+            "curriculum": data.get("curriculum"),
+        }
+    else:
+        meta = dict(data.get("meta", {}))
+    table = Table(title=str(ckpt), show_header=False)
+    table.add_column(style="cyan")
+    table.add_column()
+    kind = "training state" if data["format"] == TRAIN_FORMAT else "policy"
+    table.add_row("kind", f"{kind} ({data['format']} v{data['version']})")
+    table.add_row("env", data["env"])
+    table.add_row("obs / action size", f"{data['obs_dim']} / {data['act_dim']}")
+    for key, value in meta.items():
+        if isinstance(value, dict):
+            value = ", ".join(
+                f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"
+                for k, v in value.items()
+                if k in ("mean", "std", "episodes", "falls", "step", "stage")
+            ) or str(value)
+        table.add_row(key.replace("_", " "), "-" if value is None else str(value))
+    cfg = data["config"]
+    table.add_row("seed", str(cfg["seed"]))
+    table.add_row("agent", ", ".join(f"{k}={v}" for k, v in cfg["agent"].items()))
+    table.add_row("train", ", ".join(f"{k}={v}" for k, v in cfg["train"].items()))
+    console.print(table)
 
 
 def main(argv: list[str] | None = None) -> None:

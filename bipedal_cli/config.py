@@ -99,6 +99,21 @@ class TrainConfig:
     """First env seed of evaluation episodes (kept apart from training seeds)."""
 
 
+REPLAY_CHOICES = ("keep", "clear")
+
+
+@dataclass
+class CurriculumConfig:
+    """``bipedal curriculum``: BipedalWalker-v3 first, then BipedalWalkerHardcore-v3."""
+
+    walker_steps: int = 300_000
+    """Stage 1 budget: env steps on BipedalWalker-v3 (it ends earlier once solved)."""
+    hardcore_steps: int = 3_000_000
+    """Stage 2 budget: env steps on BipedalWalkerHardcore-v3 (ends earlier once solved)."""
+    replay: str = "keep"
+    """At the switch: keep the Walker transitions in the replay buffer, or clear it."""
+
+
 @dataclass
 class Config:
     """Everything a run needs; one YAML file fills it."""
@@ -111,6 +126,7 @@ class Config:
     """auto, cpu or cuda."""
     agent: AgentConfig = field(default_factory=AgentConfig)
     train: TrainConfig = field(default_factory=TrainConfig)
+    curriculum: CurriculumConfig = field(default_factory=CurriculumConfig)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)

@@ -7,6 +7,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+from .paths import atomic_path
+
 COLUMNS = [
     "kind",  # episode | eval | full_eval
     "stage",  # env id the row was produced on
@@ -44,12 +46,10 @@ class MetricsWriter:
         """Drop rows logged after ``step`` (written after the checkpoint a resume starts from)."""
         rows = read_metrics(self.path)
         kept = [r for r in rows if int(float(r["step"])) <= step]
-        tmp = self.path.with_suffix(".csv.tmp")
-        with tmp.open("w", newline="") as f:
+        with atomic_path(self.path) as tmp, tmp.open("w", newline="") as f:
             w = csv.DictWriter(f, COLUMNS)
             w.writeheader()
             w.writerows(kept)
-        tmp.replace(self.path)
 
 
 def _fmt(value: Any) -> Any:

@@ -40,6 +40,8 @@ from .errors import UserError
 from .evaluation import actor_policy, evaluate_actor, run_episodes, summarize
 from .metrics import METRICS_FILE, MetricsWriter
 
+PLOT_FILE = "learning_curve.png"
+
 
 class Reporter(Protocol):
     """What the loop tells the outside world; the CLI implements it with rich."""
@@ -122,6 +124,7 @@ class Trainer:
         self.last_eval: dict | None = None
         self.full_eval: dict | None = None
         self.last_metrics: dict[str, float] = {}
+        self.curriculum: dict[str, Any] | None = None  # set by curriculum.py
         self._stop_requested = False
 
     # ----------------------------------------------------------------- state
@@ -155,6 +158,7 @@ class Trainer:
             },
             "last_eval": self.last_eval,
             "full_eval": self.full_eval,
+            "curriculum": self.curriculum,
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -173,6 +177,7 @@ class Trainer:
         if state["rng"].get("cuda") is not None and self.device.type == "cuda":
             torch.cuda.set_rng_state_all(state["rng"]["cuda"])
         self.last_eval, self.full_eval = state["last_eval"], state["full_eval"]
+        self.curriculum = state.get("curriculum")
         ep = state["episode"]
         if ep["obs"] is not None:
             self._replay_episode(int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy())
@@ -308,6 +313,7 @@ class Trainer:
             if previous is not None:
                 signal.signal(signal.SIGINT, previous)
         self.save()
+        self.write_plot()
         self.reporter.update(self.snapshot(steps_per_s))
         self.reporter.close()
         return TrainResult(
@@ -320,12 +326,37 @@ class Trainer:
             self.full_eval,
         )
 
+    def write_plot(self) -> Path | None:
+        """``learning_curve.png`` in the run directory (skipped before the first episode ends)."""
+        from .plotting import plot_runs
+
+        if self.episodes == 0:
+            return None
+        return plot_runs([self.run_dir], self.run_dir / PLOT_FILE, title=self.run_dir.name)
+
     def _fresh_env(self) -> None:
         # A Box2D world keeps history across resets (body and contact ordering), so the same
         # seed and actions give another trajectory in a reused env. A new env per episode makes
         # an episode a pure function of (seed, actions): what exact resume relies on.
         self.env.close()
         self.env = make_env(self.cfg.env)
+
+    def switch_env(self, env_id: str, clear_buffer: bool) -> None:
+        """Continue on another env with the same networks, optimizers and temperature.
+
+        The episode in progress is dropped (it is not counted); evaluations now use ``env_id``.
+        """
+        self.cfg.env = env_id
+        probe = make_env(env_id)
+        dims = env_dims(probe)
+        probe.close()
+        if dims != (self.obs_dim, self.act_dim):
+            raise UserError(f"{env_id}: observation/action sizes {dims} differ from the agent's")
+        if clear_buffer:
+            self.buffer.size = self.buffer.pos = 0
+        self.last_eval = self.full_eval = None
+        self.recent_returns.clear()
+        self._start_episode()
 
     def _start_episode(self) -> None:
         seed = int(self.rng.integers(2**31 - 1))
@@ -421,10 +452,11 @@ def prepare_new_run_dir(run_dir: str | Path, option: str = "--run-dir") -> Path:
     return run_dir
 
 
-def default_run_dir(cfg: Config, root: str | Path = "runs") -> Path:
-    short = "hardcore" if "Hardcore" in cfg.env else "walker"
+def default_run_dir(cfg: Config, kind: str | None = None, root: str | Path = "runs") -> Path:
+    """``runs/<kind>-seed<S>-<time>``; kind defaults to walker or hardcore."""
+    kind = kind or ("hardcore" if "Hardcore" in cfg.env else "walker")
     stamp = time.strftime("%Y%m%d-%H%M%S")
-    return Path(root) / f"{short}-seed{cfg.seed}-{stamp}"
+    return Path(root) / f"{kind}-seed{cfg.seed}-{stamp}"
 
 
 def train(
@@ -439,14 +471,10 @@ def train(
     return trainer.run(until_solved=until_solved)
 
 
-def resume(
-    path: str | Path,
-    total_steps: int | None = None,
-    reporter: Reporter | None = None,
-    until_solved: bool = False,
-    device: str | None = None,
-) -> TrainResult:
-    """Continue the run whose ``state.pt`` is ``path`` (or lies in the directory ``path``)."""
+def load_trainer(
+    path: str | Path, reporter: Reporter | None = None, device: str | None = None
+) -> Trainer:
+    """A Trainer restored from ``path`` (a run directory or its ``state.pt``), ready to run."""
     path = Path(path)
     state_path = path / STATE_FILE if path.is_dir() else path
     if path.is_dir() and not state_path.exists():
@@ -465,4 +493,28 @@ def resume(
     metrics_path = state_path.parent / METRICS_FILE
     if metrics_path.exists():
         MetricsWriter(metrics_path).truncate_after(trainer.step)
+    return trainer
+
+
+def resume(
+    path: str | Path,
+    total_steps: int | None = None,
+    reporter: Reporter | None = None,
+    until_solved: bool = False,
+    device: str | None = None,
+):
+    """Continue the run at ``path``; a curriculum run continues inside its current stage.
+
+    Returns a :class:`TrainResult`, or a ``CurriculumResult`` for a curriculum run.
+    """
+    trainer = load_trainer(path, reporter, device)
+    if trainer.curriculum is not None:
+        from .curriculum import continue_curriculum
+
+        if total_steps is not None:
+            raise UserError(
+                "--steps: a curriculum run takes its budgets from its config "
+                "(curriculum.walker_steps, curriculum.hardcore_steps)"
+            )
+        return continue_curriculum(trainer)
     return trainer.run(total_steps=total_steps, until_solved=until_solved)

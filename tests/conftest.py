@@ -35,3 +35,9 @@ def tiny_dict(**train) -> dict:
 @pytest.fixture
 def tiny_config() -> Config:
     return config_from_dict(tiny_dict())
+
+
+@pytest.fixture(autouse=True)
+def wide_console(monkeypatch):
+    """Rich tables fit the terminal width; keep captured output from being truncated."""
+    monkeypatch.setenv("COLUMNS", "200")

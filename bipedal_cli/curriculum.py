@@ -1,0 +1,75 @@
+"""``bipedal curriculum``: BipedalWalker-v3 until solved (or its budget), then Hardcore.
+
+Stage 2 continues with the same networks, optimizers, temperature and RNGs in the same run
+directory; ``curriculum.replay`` says whether the Walker transitions stay in the replay buffer
+(``keep``, the default: early Hardcore updates still see flat ground) or are dropped (``clear``).
+The stage is recorded in the training state, so ``bipedal resume`` continues inside the right
+stage, and in ``metrics.csv`` (the ``stage`` column).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .config import ENV_ALIASES, Config
+from .train import Reporter, Trainer, TrainResult, default_run_dir, prepare_new_run_dir
+
+STAGES = (ENV_ALIASES["walker"], ENV_ALIASES["hardcore"])
+
+
+@dataclass
+class CurriculumResult:
+    run_dir: Path
+    stages: list[dict[str, Any]]  # per finished stage: env, steps, episodes, wall_time, eval
+    stopped: str
+
+
+def _stage_summary(trainer: Trainer, result: TrainResult, start: dict[str, float]) -> dict:
+    return {
+        "env": trainer.cfg.env,
+        "stopped": result.stopped,
+        "steps": result.steps - int(start["step"]),
+        "episodes": result.episodes - int(start["episodes"]),
+        "wall_time": result.wall_time - start["wall_time"],
+        "last_eval": result.last_eval,
+        "full_eval": result.full_eval,
+    }
+
+
+def start_curriculum(
+    cfg: Config, run_dir: str | Path | None = None, reporter: Reporter | None = None
+) -> CurriculumResult:
+    cfg.env = STAGES[0]
+    run_dir = prepare_new_run_dir(run_dir or default_run_dir(cfg, "curriculum"))
+    trainer = Trainer(cfg, run_dir, reporter)
+    trainer.curriculum = {"stage": 0, "stage_start": _counters(trainer), "finished": []}
+    return continue_curriculum(trainer)
+
+
+def _counters(trainer: Trainer) -> dict[str, float]:
+    return {"step": trainer.step, "episodes": trainer.episodes, "wall_time": trainer.wall_time}
+
+
+def continue_curriculum(trainer: Trainer) -> CurriculumResult:
+    """Run the remaining stages of a curriculum trainer (new or resumed)."""
+    state = trainer.curriculum
+    c = trainer.cfg.curriculum
+    budgets = (c.walker_steps, c.hardcore_steps)
+    stopped = "budget"
+    while state["stage"] < len(STAGES):
+        stage = state["stage"]
+        start = state["stage_start"]
+        result = trainer.run(total_steps=int(start["step"]) + budgets[stage], until_solved=True)
+        if result.stopped == "interrupted":
+            stopped = "interrupted"
+            break
+        state["finished"].append(_stage_summary(trainer, result, start))
+        stopped = result.stopped
+        state["stage"] = stage + 1
+        if state["stage"] < len(STAGES):
+            trainer.switch_env(STAGES[state["stage"]], clear_buffer=c.replay == "clear")
+            state["stage_start"] = _counters(trainer)
+        trainer.save()
+    return CurriculumResult(trainer.run_dir, list(state["finished"]), stopped)

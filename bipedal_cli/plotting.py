@@ -1,0 +1,150 @@
+"""Learning curves like the paper's figures, from runs' ``metrics.csv`` (matplotlib, off-screen)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import UserError
+from .metrics import METRICS_FILE, read_metrics
+from .paths import atomic_path
+
+PLOT_SUFFIXES = (".png", ".svg")
+
+
+@dataclass
+class RunCurve:
+    label: str
+    steps: np.ndarray  # env steps at the end of each training episode
+    returns: np.ndarray  # training episode returns
+    eval_steps: np.ndarray
+    eval_means: np.ndarray
+    stages: list[tuple[str, int]]  # (env id, first step) per curriculum stage
+
+
+def load_run(run_dir: str | Path, label: str | None = None) -> RunCurve:
+    run_dir = Path(run_dir)
+    path = run_dir / METRICS_FILE if run_dir.is_dir() else run_dir
+    if not path.is_file():
+        raise UserError(
+            f"RUN_DIR {run_dir}: no {METRICS_FILE}; expected a directory written by `bipedal train`"
+        )
+    try:
+        rows = read_metrics(path)
+        episodes = [r for r in rows if r["kind"] == "episode"]
+        evals = [r for r in rows if r["kind"] in ("eval", "full_eval")]
+        steps = np.array([float(r["step"]) for r in episodes])
+        returns = np.array([float(r["return"]) for r in episodes])
+        eval_steps = np.array([float(r["step"]) for r in evals])
+        eval_means = np.array([float(r["return"]) for r in evals])
+    except (KeyError, ValueError):
+        raise UserError(
+            f"RUN_DIR {run_dir}: {METRICS_FILE} is not a bipedal metrics file"
+        ) from None
+    if len(episodes) == 0:
+        raise UserError(f"RUN_DIR {run_dir}: {METRICS_FILE} has no finished episodes yet")
+    stages: list[tuple[str, int]] = []
+    for r in episodes:
+        if not stages or stages[-1][0] != r["stage"]:
+            stages.append((r["stage"], int(float(r["step"]))))
+    name = label or (run_dir.name if run_dir.is_dir() else run_dir.parent.name)
+    return RunCurve(name, steps, returns, eval_steps, eval_means, stages)
+
+
+def moving_stats(values: np.ndarray, window: int = 10) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and standard deviation over the last ``window`` values (fewer at the start)."""
+    means = np.empty(len(values))
+    stds = np.empty(len(values))
+    for i in range(len(values)):
+        chunk = values[max(0, i - window + 1) : i + 1]
+        means[i], stds[i] = chunk.mean(), chunk.std()
+    return means, stds
+
+
+def aggregate(
+    curves: list[RunCurve], points: int = 200
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Across runs: the 10-episode moving mean interpolated on a common step grid -> mean, std."""
+    end = min(c.steps[-1] for c in curves)
+    grid = np.linspace(0, end, points)
+    stacked = np.stack([np.interp(grid, c.steps, moving_stats(c.returns)[0]) for c in curves])
+    return grid, stacked.mean(0), stacked.std(0)
+
+
+def plot_runs(
+    run_dirs: list[Path],
+    out: Path,
+    labels: list[str] | None = None,
+    aggregate_by_label: bool = False,
+    title: str | None = None,
+    threshold: float = 300.0,
+) -> Path:
+    """Episode return against env steps: moving mean over 10 episodes with +-1 std band,
+    evaluations as points, the solved line; several runs overlaid, or averaged per label."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if labels and len(labels) != len(run_dirs):
+        raise UserError(f"--label: given {len(labels)} labels for {len(run_dirs)} runs")
+    curves = [load_run(d, labels[i] if labels else None) for i, d in enumerate(run_dirs)]
+    fig, ax = plt.subplots(figsize=(8, 4.8), dpi=110)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    groups: dict[str, list[RunCurve]] = {}
+    for c in curves:
+        groups.setdefault(c.label if aggregate_by_label else f"{c.label}#{len(groups)}", []).append(
+            c
+        )
+    for i, (key, members) in enumerate(groups.items()):
+        color = colors[i % len(colors)]
+        label = key.split("#")[0]
+        if len(members) > 1:
+            grid, mean, std = aggregate(members)
+            ax.plot(grid, mean, color=color, label=f"{label} (mean of {len(members)} runs)")
+            ax.fill_between(grid, mean - std, mean + std, color=color, alpha=0.2)
+        else:
+            c = members[0]
+            mean, std = moving_stats(c.returns)
+            ax.plot(c.steps, mean, color=color, label=f"{label}")
+            ax.fill_between(c.steps, mean - std, mean + std, color=color, alpha=0.2)
+        for c in members:
+            if len(c.eval_steps):
+                ax.scatter(
+                    c.eval_steps,
+                    c.eval_means,
+                    color=color,
+                    s=14,
+                    marker="o",
+                    edgecolors="black",
+                    linewidths=0.4,
+                    zorder=3,
+                )
+            for env_id, start in c.stages[1:]:
+                ax.axvline(start, color=color, linestyle=":", linewidth=1)
+                ax.text(
+                    start,
+                    ax.get_ylim()[0],
+                    f" {env_id}",
+                    color=color,
+                    fontsize=7,
+                    rotation=90,
+                    va="bottom",
+                )
+    ax.axhline(
+        threshold, color="black", linestyle="--", linewidth=1, label=f"solved ({threshold:g})"
+    )
+    ax.set_xlabel("env steps")
+    ax.set_ylabel("episode return")
+    ax.set_title(title or "moving mean over 10 episodes (band: +-1 std); points: evaluations")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="lower right", fontsize=8)
+    fig.tight_layout()
+    try:
+        with atomic_path(out) as tmp:
+            fig.savefig(tmp, format=out.suffix.lstrip(".").lower())
+    finally:
+        plt.close(fig)
+    return out
