@@ -1,0 +1,259 @@
+"""Training throughput: bipedal's TQC + D2RL against sb3-contrib's TQC at the paper's sizes.
+
+    pip install -e ".[bench]"
+    python benchmarks/throughput.py                 # both, 1 and 2 threads, a few minutes
+    python benchmarks/throughput.py --threads 1 --steps 1000 --skip-sb3
+
+Every measurement runs in its own subprocess (clean thread settings, clean peak memory). Both
+implementations use 5 critics x 25 quantiles (drop 2 per net), critics 2 x 256, actor 2 x 512,
+batch 64, one gradient step per env step, gamma 0.98, 1,000 random warm-up steps that are not
+timed. "env steps/s" is full training after warm-up: env step, replay buffer, gradient step.
+sb3's networks are plain MLPs; ours are D2RL (slightly more work per layer).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+WARMUP = 1000
+
+
+def cpu_name() -> str:
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def measure_ours(threads: int, steps: int, device: str, eval_episodes: int) -> dict:
+    import numpy as np
+    import torch
+
+    from bipedal_cli.config import config_from_dict
+    from bipedal_cli.evaluation import evaluate_actor
+    from bipedal_cli.train import NullReporter, Trainer
+
+    cfg = config_from_dict(
+        {
+            "device": device,
+            "train": {
+                "warmup_steps": WARMUP,
+                "eval_every": 0,
+                "checkpoint_every": 0,
+                "threads": threads,
+                "buffer_size": 100_000,
+            },
+        }
+    )
+
+    class Clock(NullReporter):
+        """The loop reports every 50 steps: time the span between reports, not the final save."""
+
+        marks: list[tuple[int, float]] = []
+
+        def update(self, snapshot):
+            if device != "cpu":
+                torch.cuda.synchronize()
+            self.marks.append((snapshot["step"], time.perf_counter()))
+
+    clock = Clock()
+    trainer = Trainer(cfg, tempfile.mkdtemp(prefix="bipedal-bench-"), clock)
+    torch.set_num_threads(threads)
+    trainer.run(total_steps=WARMUP + 100 + steps)
+    timed = [(s, t) for s, t in clock.marks if s >= WARMUP + 100]
+    (s0, t0), (s1, t1) = timed[0], timed[-2]  # the last mark comes after the final save
+    train_sps = (s1 - s0) / (t1 - t0)
+
+    # Gradient steps alone, on batches sampled beforehand.
+    rng = np.random.default_rng(0)
+    batches = [trainer.agent.batch_to_tensors(trainer.buffer.sample(64, rng)) for _ in range(steps)]
+    start = time.perf_counter()
+    for b in batches:
+        trainer.agent.update(b)
+    if device != "cpu":
+        torch.cuda.synchronize()
+    update_sps = len(batches) / (time.perf_counter() - start)
+
+    result = {"env_steps_per_s": train_sps, "updates_per_s": update_sps}
+    if eval_episodes:
+        actor, policy_source = trainer.agent.actor, "the benchmark's briefly trained actor"
+        shipped = os.path.join(os.path.dirname(__file__), "..", "checkpoints", "bipedal_walker.pt")
+        if os.path.exists(shipped):
+            from bipedal_cli.checkpoint import actor_from_checkpoint, load_checkpoint
+
+            actor, _ = actor_from_checkpoint(load_checkpoint(shipped))
+            policy_source = "checkpoints/bipedal_walker.pt"
+        seeds = list(range(eval_episodes))
+        start = time.perf_counter()
+        episodes = evaluate_actor(actor, cfg.agent, cfg.env, seeds, workers=0)
+        result["eval_s"] = time.perf_counter() - start
+        result["eval_episodes"] = eval_episodes
+        result["eval_env_steps"] = sum(e.length for e in episodes)
+        result["eval_policy"] = policy_source
+    result["peak_rss_mb"] = peak_rss_mb()
+    return result
+
+
+def measure_sb3(threads: int, steps: int) -> dict:
+    import gymnasium as gym
+    import torch
+    from sb3_contrib import TQC
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    torch.set_num_threads(threads)
+    marks: dict[str, float] = {}
+
+    class Clock(BaseCallback):
+        def _on_step(self) -> bool:
+            if self.num_timesteps == WARMUP + 50:
+                marks["start"] = time.perf_counter()
+            return True
+
+    model = TQC(
+        "MlpPolicy",
+        gym.make("BipedalWalker-v3"),
+        learning_rate=3.296e-4,
+        buffer_size=100_000,
+        learning_starts=WARMUP,
+        batch_size=64,
+        tau=0.005,
+        gamma=0.98,
+        train_freq=1,
+        gradient_steps=1,
+        top_quantiles_to_drop_per_net=2,
+        policy_kwargs={
+            "n_critics": 5,
+            "n_quantiles": 25,
+            "net_arch": {"pi": [512, 512], "qf": [256, 256]},
+        },
+        device="cpu",
+        seed=0,
+        verbose=0,
+    )
+    model.learn(total_timesteps=WARMUP + 50 + steps, callback=Clock())
+    train_sps = steps / (time.perf_counter() - marks["start"])
+    return {"env_steps_per_s": train_sps, "peak_rss_mb": peak_rss_mb()}
+
+
+def child(args) -> None:
+    if args.impl == "ours":
+        out = measure_ours(args.threads, args.steps, args.device, args.eval_episodes)
+    else:
+        out = measure_sb3(args.threads, args.steps)
+    print("RESULT " + json.dumps(out))
+
+
+def run_child(impl: str, threads: int, steps: int, device: str, eval_episodes: int) -> dict:
+    cmd = [
+        sys.executable,
+        __file__,
+        "--child",
+        impl,
+        "--threads",
+        str(threads),
+        "--steps",
+        str(steps),
+        "--device",
+        device,
+        "--eval-episodes",
+        str(eval_episodes),
+    ]
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads), MKL_NUM_THREADS=str(threads))
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    for line in proc.stdout.splitlines():
+        if line.startswith("RESULT "):
+            return json.loads(line[len("RESULT ") :])
+    raise RuntimeError(f"{impl} with {threads} threads failed:\n{proc.stderr[-3000:]}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--steps", type=int, default=2000, help="timed env steps per run")
+    parser.add_argument("--sb3-steps", type=int, default=600, help="timed env steps for sb3")
+    parser.add_argument("--device", default="cpu")
+    parser.add_argument("--eval-episodes", type=int, default=100)
+    parser.add_argument("--skip-sb3", action="store_true")
+    parser.add_argument("--json", help="also write the results here")
+    parser.add_argument("--child", choices=["ours", "sb3"], help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        args.impl = args.child
+        args.threads = args.threads[0]
+        child(args)
+        return
+
+    import torch
+
+    print(f"machine: {cpu_name()}, {os.cpu_count()} cores, {platform.platform()}")
+    print(f"python {platform.python_version()}, torch {torch.__version__}, device {args.device}")
+    rows = []
+    for threads in args.threads:
+        ours = run_child(
+            "ours",
+            threads,
+            args.steps,
+            args.device,
+            args.eval_episodes if threads == args.threads[0] else 0,
+        )
+        sb3 = None if args.skip_sb3 else run_child("sb3", threads, args.sb3_steps, "cpu", 0)
+        rows.append({"threads": threads, "ours": ours, "sb3": sb3})
+        ratio = f"{ours['env_steps_per_s'] / sb3['env_steps_per_s']:.1f}x" if sb3 else "-"
+        print(
+            f"threads {threads}: bipedal {ours['env_steps_per_s']:.1f} env steps/s "
+            f"({ours['updates_per_s']:.1f} updates/s alone, peak {ours['peak_rss_mb']:.0f} MB); "
+            + (
+                f"sb3-contrib TQC {sb3['env_steps_per_s']:.1f} env steps/s "
+                f"(peak {sb3['peak_rss_mb']:.0f} MB); ratio {ratio}"
+                if sb3
+                else "sb3 skipped"
+            ),
+            flush=True,
+        )
+    print()
+    header = ["threads", "bipedal env steps/s", "bipedal updates/s (alone)"]
+    header += ["sb3-contrib TQC env steps/s", "ratio"]
+    print("| " + " | ".join(header) + " |")
+    print("|---|---|---|---|---|")
+    for r in rows:
+        o, s = r["ours"], r["sb3"]
+        print(
+            f"| {r['threads']} | {o['env_steps_per_s']:.1f} | {o['updates_per_s']:.1f} | "
+            + (
+                f"{s['env_steps_per_s']:.1f} | {o['env_steps_per_s'] / s['env_steps_per_s']:.1f}x |"
+                if s
+                else "- | - |"
+            )
+        )
+    first = rows[0]["ours"]
+    if "eval_s" in first:
+        print(
+            f"\n100-episode evaluation ({first['eval_policy']}, every core): "
+            f"{first['eval_s']:.1f} s for {first['eval_episodes']} episodes, "
+            f"{first['eval_env_steps']:,} env steps"
+        )
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(
+                {"machine": cpu_name(), "torch": torch.__version__, "rows": rows}, f, indent=2
+            )
+
+
+if __name__ == "__main__":
+    main()
