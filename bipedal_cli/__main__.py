@@ -1,5 +1,6 @@
+"""``python -m bipedal_cli``: the same as the ``bipedal`` command."""
+
 from .cli import main
 
-# The guard matters: evaluation workers are spawned processes, which import __main__ again.
 if __name__ == "__main__":
     main()

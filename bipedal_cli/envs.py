@@ -29,4 +29,4 @@ def env_dims(env: gym.Env) -> tuple[int, int]:
 
 def is_fall(terminated: bool, reward: float) -> bool:
     """An episode that terminated on the fall penalty (as opposed to reaching the end)."""
-    return bool(terminated) and reward <= FALL_REWARD
+    return bool(terminated and reward <= FALL_REWARD)

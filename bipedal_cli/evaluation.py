@@ -95,7 +95,9 @@ def evaluate_actor(
 ) -> list[EpisodeResult]:
     """Evaluate ``actor`` (on CPU) on one episode per seed; ``workers=0`` uses every core.
 
-    ``on_episodes(n)`` is called as chunks of episodes finish (for progress bars).
+    ``on_episodes(n)`` is called as chunks of episodes finish (for progress bars). Workers are
+    spawned processes, so a script that calls this (or ``train(..., until_solved=True)``) needs
+    Python's ``if __name__ == "__main__":`` guard.
     """
     workers = workers or min(os.cpu_count() or 1, max(1, len(seeds) // chunk))
     state = {k: v.detach().cpu() for k, v in actor.state_dict().items()}

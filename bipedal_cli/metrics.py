@@ -7,6 +7,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .paths import atomic_path
 
 COLUMNS = [
@@ -53,10 +55,10 @@ class MetricsWriter:
 
 
 def _fmt(value: Any) -> Any:
-    if isinstance(value, float):
-        return "" if math.isnan(value) else f"{value:.6g}"
-    if isinstance(value, bool):
+    if isinstance(value, (bool, np.bool_)):
         return int(value)
+    if isinstance(value, (float, np.floating)):
+        return "" if math.isnan(value) else f"{float(value):.6g}"
     return value
 
 
