@@ -352,13 +352,19 @@ def plot(
         bool, typer.Option("--aggregate", help="Average runs that share a label (seeds).")
     ] = False,
     title: Annotated[str | None, typer.Option("--title")] = None,
+    metric: Annotated[
+        str,
+        typer.Option(
+            "--metric", help="return | alpha | critic_loss | actor_loss | entropy | q_mean | length"
+        ),
+    ] = "return",
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
     """Learning curves: 10-episode moving mean with a +-1 std band, evaluations, the 300 line."""
     from .plotting import PLOT_SUFFIXES, plot_runs
 
     check_output_path(out, "--out", PLOT_SUFFIXES, force)
-    plot_runs(runs, out, label, aggregate, title)
+    plot_runs(runs, out, label, aggregate, title, metric=metric)
     console.print(f"wrote {out}")
 
 
@@ -402,7 +408,7 @@ def info(ckpt: Annotated[Path, typer.Argument(metavar="CKPT")]) -> None:
             "curriculum": data.get("curriculum"),
         }
     else:
-        meta = dict(data.get("meta", {}))
+        meta = {k: v for k, v in data.get("meta", {}).items() if k not in ("env", "seed")}
     table = Table(title=str(ckpt), show_header=False)
     table.add_column(style="cyan")
     table.add_column()

@@ -12,19 +12,23 @@ from .metrics import METRICS_FILE, read_metrics
 from .paths import atomic_path
 
 PLOT_SUFFIXES = (".png", ".svg")
+PLOT_METRICS = ("return", "alpha", "critic_loss", "actor_loss", "entropy", "q_mean", "length")
 
 
 @dataclass
 class RunCurve:
     label: str
     steps: np.ndarray  # env steps at the end of each training episode
-    returns: np.ndarray  # training episode returns
+    values: np.ndarray  # the plotted metric per training episode (return by default)
     eval_steps: np.ndarray
     eval_means: np.ndarray
     stages: list[tuple[str, int]]  # (env id, first step) per curriculum stage
 
 
-def load_run(run_dir: str | Path, label: str | None = None) -> RunCurve:
+def load_run(run_dir: str | Path, label: str | None = None, metric: str = "return") -> RunCurve:
+    """A run's training episodes (metric per episode) and evaluations from its metrics.csv."""
+    if metric not in PLOT_METRICS:
+        raise UserError(f"--metric {metric}: expected one of {', '.join(PLOT_METRICS)}")
     run_dir = Path(run_dir)
     path = run_dir / METRICS_FILE if run_dir.is_dir() else run_dir
     if not path.is_file():
@@ -33,10 +37,11 @@ def load_run(run_dir: str | Path, label: str | None = None) -> RunCurve:
         )
     try:
         rows = read_metrics(path)
-        episodes = [r for r in rows if r["kind"] == "episode"]
+        # losses and alpha are empty during warm-up: those episodes have nothing to plot
+        episodes = [r for r in rows if r["kind"] == "episode" and r[metric] != ""]
         evals = [r for r in rows if r["kind"] in ("eval", "full_eval")]
         steps = np.array([float(r["step"]) for r in episodes])
-        returns = np.array([float(r["return"]) for r in episodes])
+        values = np.array([float(r[metric]) for r in episodes])
         eval_steps = np.array([float(r["step"]) for r in evals])
         eval_means = np.array([float(r["return"]) for r in evals])
     except (KeyError, ValueError):
@@ -50,7 +55,9 @@ def load_run(run_dir: str | Path, label: str | None = None) -> RunCurve:
         if not stages or stages[-1][0] != r["stage"]:
             stages.append((r["stage"], int(float(r["step"]))))
     name = label or (run_dir.name if run_dir.is_dir() else run_dir.parent.name)
-    return RunCurve(name, steps, returns, eval_steps, eval_means, stages)
+    if metric != "return":
+        eval_steps, eval_means = np.zeros(0), np.zeros(0)
+    return RunCurve(name, steps, values, eval_steps, eval_means, stages)
 
 
 def moving_stats(values: np.ndarray, window: int = 10) -> tuple[np.ndarray, np.ndarray]:
@@ -69,7 +76,7 @@ def aggregate(
     """Across runs: the 10-episode moving mean interpolated on a common step grid -> mean, std."""
     end = min(c.steps[-1] for c in curves)
     grid = np.linspace(0, end, points)
-    stacked = np.stack([np.interp(grid, c.steps, moving_stats(c.returns)[0]) for c in curves])
+    stacked = np.stack([np.interp(grid, c.steps, moving_stats(c.values)[0]) for c in curves])
     return grid, stacked.mean(0), stacked.std(0)
 
 
@@ -80,6 +87,7 @@ def plot_runs(
     aggregate_by_label: bool = False,
     title: str | None = None,
     threshold: float = 300.0,
+    metric: str = "return",
 ) -> Path:
     """Episode return against env steps: moving mean over 10 episodes with +-1 std band,
     evaluations as points, the solved line; several runs overlaid, or averaged per label."""
@@ -90,7 +98,7 @@ def plot_runs(
 
     if labels and len(labels) != len(run_dirs):
         raise UserError(f"--label: given {len(labels)} labels for {len(run_dirs)} runs")
-    curves = [load_run(d, labels[i] if labels else None) for i, d in enumerate(run_dirs)]
+    curves = [load_run(d, labels[i] if labels else None, metric) for i, d in enumerate(run_dirs)]
     fig, ax = plt.subplots(figsize=(8, 4.8), dpi=110)
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     groups: dict[str, list[RunCurve]] = {}
@@ -107,7 +115,7 @@ def plot_runs(
             ax.fill_between(grid, mean - std, mean + std, color=color, alpha=0.2)
         else:
             c = members[0]
-            mean, std = moving_stats(c.returns)
+            mean, std = moving_stats(c.values)
             ax.plot(c.steps, mean, color=color, label=f"{label}")
             ax.fill_between(c.steps, mean - std, mean + std, color=color, alpha=0.2)
         for c in members:
@@ -133,14 +141,20 @@ def plot_runs(
                     rotation=90,
                     va="bottom",
                 )
-    ax.axhline(
-        threshold, color="black", linestyle="--", linewidth=1, label=f"solved ({threshold:g})"
-    )
+    if metric == "return":
+        ax.axhline(
+            threshold, color="black", linestyle="--", linewidth=1, label=f"solved ({threshold:g})"
+        )
+    if metric == "alpha":
+        ax.set_yscale("log")
     ax.set_xlabel("env steps")
-    ax.set_ylabel("episode return")
-    ax.set_title(title or "moving mean over 10 episodes (band: +-1 std); points: evaluations")
+    ax.set_ylabel("episode return" if metric == "return" else f"{metric} (at episode end)")
+    default_title = "moving mean over 10 episodes (band: +-1 std)"
+    if metric == "return":
+        default_title += "; points: evaluations"
+    ax.set_title(title or default_title)
     ax.grid(alpha=0.3)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="lower right" if metric == "return" else "best", fontsize=8)
     fig.tight_layout()
     try:
         with atomic_path(out) as tmp:

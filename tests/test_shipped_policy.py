@@ -1,0 +1,30 @@
+"""The shipped policy walks: a few episodes of the 100-episode protocol, not all of them."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from bipedal_cli.checkpoint import actor_from_checkpoint, load_checkpoint
+from bipedal_cli.evaluation import evaluate_actor
+
+ROOT = Path(__file__).resolve().parent.parent
+POLICY = ROOT / "checkpoints" / "bipedal_walker.pt"
+REPORT = ROOT / "checkpoints" / "bipedal_walker.eval.json"
+
+
+@pytest.mark.skipif(not POLICY.exists(), reason="no shipped policy")
+def test_shipped_policy_solves_its_first_evaluation_episodes():
+    data = load_checkpoint(POLICY)
+    meta = data["meta"]
+    assert data["env"] == "BipedalWalker-v3"
+    assert meta["full_eval"]["episodes"] == 100 and meta["full_eval"]["mean"] > 300
+    actor, cfg = actor_from_checkpoint(data)
+    episodes = evaluate_actor(actor, cfg.agent, "BipedalWalker-v3", [0, 1, 2, 3, 4], workers=1)
+    recorded = json.loads(REPORT.read_text())
+    assert recorded["summary"]["episodes"] == 100 and recorded["summary"]["mean"] > 300
+    for got, want in zip(episodes, recorded["episodes"][:5], strict=True):
+        assert got.seed == want["seed"]
+        assert not got.fell and got.ret > 300
+        # same chunk of 5 as `bipedal eval`: equal here, within a point on another CPU
+        assert got.ret == pytest.approx(want["ret"], abs=1.0)
