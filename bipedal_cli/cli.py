@@ -51,8 +51,13 @@ DeviceOpt = Annotated[str | None, typer.Option("--device", help="auto | cpu | cu
 
 def _summary_line(result) -> str:
     minutes = result.wall_time / 60
+    why = {
+        "budget": "step budget reached",
+        "solved": "solved",
+        "interrupted": "interrupted, checkpoint saved",
+    }[result.stopped]
     return (
-        f"{result.stopped}: {result.steps:,} env steps, {result.episodes:,} episodes, "
+        f"{why}: {result.steps:,} env steps, {result.episodes:,} episodes, "
         f"{minutes:.1f} min; run directory {result.run_dir}"
     )
 
