@@ -442,8 +442,8 @@ def main(argv: list[str] | None = None) -> None:
         rv = app(args=argv, standalone_mode=False, prog_name="bipedal")
     except UserError as exc:
         _fail(str(exc))
-    except _ABORTS:
-        print("aborted", file=sys.stderr)
+    except (KeyboardInterrupt, *_ABORTS):
+        print("bipedal: aborted", file=sys.stderr)
         sys.exit(130)
     except _CLICK_ERRORS as exc:
         if type(exc).__name__ == "NoArgsIsHelpError":

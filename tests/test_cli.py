@@ -161,3 +161,38 @@ def test_console_script_reports_errors_without_traceback(tmp_path):
     )
     assert proc.returncode == 2
     assert proc.stderr.strip() == f"bipedal: error: CKPT {tmp_path / 'missing.pt'}: no such file"
+
+
+def test_ctrl_c_saves_a_checkpoint_and_exits_cleanly(tmp_path, tiny_yaml):
+    import signal
+    import time
+
+    run = tmp_path / "run"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "bipedal_cli",
+            "train",
+            "--config",
+            str(tiny_yaml),
+            "--steps",
+            "1000000",
+            "--run-dir",
+            str(run),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.time() + 120
+    metrics = run / "metrics.csv"
+    while time.time() < deadline and (not metrics.exists() or metrics.read_text().count("\n") < 3):
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    assert "interrupted, checkpoint saved" in out
+    state = load_checkpoint(run / "state.pt")
+    assert 0 < state["counters"]["step"] < 1_000_000
+    assert load_checkpoint(run / "policy.pt")["meta"]["steps"] == state["counters"]["step"]
