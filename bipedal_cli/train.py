@@ -25,6 +25,7 @@ import torch
 import yaml
 
 from .agent import TQCAgent
+from .buffer import ReplayBuffer
 from .checkpoint import (
     FORMAT_VERSION,
     POLICY_FILE,
@@ -111,8 +112,6 @@ class Trainer:
         self.obs_dim, self.act_dim = env_dims(self.env)
         self.agent = TQCAgent(cfg.agent, self.obs_dim, self.act_dim, self.device)
         self.agent.noise.manual_seed(cfg.seed + 1)
-        from .buffer import ReplayBuffer
-
         self.buffer = ReplayBuffer(cfg.train.buffer_size, self.obs_dim, self.act_dim)
         self.rng = np.random.default_rng(cfg.seed)
         self.step = 0
@@ -124,6 +123,7 @@ class Trainer:
         self.last_eval: dict | None = None
         self.full_eval: dict | None = None
         self.last_metrics: dict[str, float] = {}
+        self._update_metrics: dict[str, torch.Tensor] | None = None  # last update's, unsynced
         self.curriculum: dict[str, Any] | None = None  # set by curriculum.py
         self._stop_requested = False
 
@@ -281,7 +281,7 @@ class Trainer:
                         batch = self.agent.batch_to_tensors(
                             self.buffer.sample(cfg.agent.batch_size, self.rng)
                         )
-                        self._metrics_t = self.agent.update(batch)
+                        self._update_metrics = self.agent.update(batch)
                 self.wall_time = wall_base + time.perf_counter() - session_start
                 if t.eval_every and self.step % t.eval_every == 0:
                     self._periodic_eval(metrics)
@@ -392,7 +392,7 @@ class Trainer:
             self._start_episode()
 
     def _loss_metrics(self) -> dict[str, float]:
-        m = getattr(self, "_metrics_t", None)
+        m = self._update_metrics
         if m is None:
             return {}
         self.last_metrics = {
