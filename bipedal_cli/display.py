@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 from rich.console import Console, Group
@@ -45,6 +46,8 @@ class TrainingDisplay:
             refresh_per_second=4,
         )
         self.task = None
+        self.line_every_s = 30.0
+        self._last_line = time.monotonic()
 
     def stats_table(self) -> Table:
         s = self.snapshot
@@ -83,6 +86,18 @@ class TrainingDisplay:
         self.snapshot = snapshot
         desc = f"{self.title} ({snapshot.get('phase', '')})"
         self.progress.update(self.task, completed=snapshot["step"], description=desc)
+        # Not a terminal (nohup, a log file): no live display, so a plain line now and then.
+        now = time.monotonic()
+        if not self.console.is_terminal and now - self._last_line >= self.line_every_s:
+            self._last_line = now
+            s = snapshot
+            self.console.print(
+                f"step {s['step']:,}  episodes {s.get('episodes', 0):,}  "
+                f"steps/s {_num(s.get('steps_per_s'))}  return (avg 10) "
+                f"{_num(s.get('avg_return'))}  last eval {_num(s.get('last_eval'))}  "
+                f"alpha {_num(s.get('alpha'), '{:.4f}')}",
+                soft_wrap=True,
+            )
 
     def log(self, text: str) -> None:
         self.progress.console.log(text)

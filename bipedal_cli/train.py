@@ -284,22 +284,9 @@ class Trainer:
                         self._update_metrics = self.agent.update(batch)
                 self.wall_time = wall_base + time.perf_counter() - session_start
                 if t.eval_every and self.step % t.eval_every == 0:
-                    self._periodic_eval(metrics)
-                    if until_solved and self.last_eval["mean"] > t.solved_threshold:
-                        self.reporter.log(
-                            f"step {self.step}: evaluation {self.last_eval['mean']:.1f} > "
-                            f"{t.solved_threshold:g}; running the {t.solved_episodes}-episode test"
-                        )
-                        self.full_eval = self.full_evaluation()
-                        self.full_eval["step"] = self.step
-                        metrics.write(self._eval_row("full_eval", self.full_eval))
-                        self.reporter.log(
-                            f"{t.solved_episodes}-episode evaluation: "
-                            f"{self.full_eval['mean']:.1f} +- {self.full_eval['std']:.1f}"
-                        )
-                        if self.full_eval["solved"]:
-                            stopped = "solved"
-                            break
+                    if self._evaluate(metrics, until_solved):
+                        stopped = "solved"
+                        break
                 if t.checkpoint_every and self.step % t.checkpoint_every == 0:
                     self.save()
                 if self.step % 50 == 0:
@@ -418,11 +405,28 @@ class Trainer:
             **self._common(),
         }
 
-    def _periodic_eval(self, metrics: MetricsWriter) -> None:
+    def _evaluate(self, metrics: MetricsWriter, until_solved: bool) -> bool:
+        """The periodic evaluation; with ``until_solved``, the full test once it passes the
+        threshold. Returns True when the full test says solved."""
+        t = self.cfg.train
         self.reporter.update({**self.snapshot(0.0), "phase": "evaluating"})
-        self.last_eval = self.evaluate(self.cfg.train.eval_episodes)
+        self.last_eval = self.evaluate(t.eval_episodes)
         self.last_eval["step"] = self.step
         metrics.write(self._eval_row("eval", self.last_eval))
+        if not until_solved or self.last_eval["mean"] <= t.solved_threshold:
+            return False
+        self.reporter.log(
+            f"step {self.step}: evaluation {self.last_eval['mean']:.1f} > "
+            f"{t.solved_threshold:g}; running the {t.solved_episodes}-episode test"
+        )
+        self.full_eval = self.full_evaluation()
+        self.full_eval["step"] = self.step
+        metrics.write(self._eval_row("full_eval", self.full_eval))
+        self.reporter.log(
+            f"{t.solved_episodes}-episode evaluation: "
+            f"{self.full_eval['mean']:.1f} +- {self.full_eval['std']:.1f}"
+        )
+        return self.full_eval["solved"]
 
     def snapshot(self, steps_per_s: float) -> dict[str, Any]:
         recent = list(self.recent_returns)
