@@ -110,13 +110,14 @@ def measure_ours(threads: int, steps: int, device: str, eval_episodes: int) -> d
     return result
 
 
-def measure_sb3(threads: int, steps: int) -> dict:
+def measure_sb3(threads: int, steps: int, flush_denormal: bool) -> dict:
     import gymnasium as gym
     import torch
     from sb3_contrib import TQC
     from stable_baselines3.common.callbacks import BaseCallback
 
     torch.set_num_threads(threads)
+    torch.set_flush_denormal(flush_denormal)
     marks: dict[str, float] = {}
 
     class Clock(BaseCallback):
@@ -155,7 +156,7 @@ def child(args) -> None:
     if args.impl == "ours":
         out = measure_ours(args.threads, args.steps, args.device, args.eval_episodes)
     else:
-        out = measure_sb3(args.threads, args.steps)
+        out = measure_sb3(args.threads, args.steps, args.child == "sb3-flush")
     print("RESULT " + json.dumps(out))
 
 
@@ -191,7 +192,7 @@ def main() -> None:
     parser.add_argument("--eval-episodes", type=int, default=100)
     parser.add_argument("--skip-sb3", action="store_true")
     parser.add_argument("--json", help="also write the results here")
-    parser.add_argument("--child", choices=["ours", "sb3"], help=argparse.SUPPRESS)
+    parser.add_argument("--child", choices=["ours", "sb3", "sb3-flush"], help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         args.impl = args.child
@@ -205,42 +206,42 @@ def main() -> None:
     print(f"python {platform.python_version()}, torch {torch.__version__}, device {args.device}")
     rows = []
     for threads in args.threads:
-        ours = run_child(
-            "ours",
-            threads,
-            args.steps,
-            args.device,
-            args.eval_episodes if threads == args.threads[0] else 0,
-        )
-        sb3 = None if args.skip_sb3 else run_child("sb3", threads, args.sb3_steps, "cpu", 0)
-        rows.append({"threads": threads, "ours": ours, "sb3": sb3})
-        ratio = f"{ours['env_steps_per_s'] / sb3['env_steps_per_s']:.1f}x" if sb3 else "-"
+        eval_episodes = args.eval_episodes if threads == args.threads[0] else 0
+        row = {"threads": threads}
+        row["ours"] = run_child("ours", threads, args.steps, args.device, eval_episodes)
+        if not args.skip_sb3:
+            # as shipped, and with the same denormal flushing we use (a one-line change for them)
+            row["sb3"] = run_child("sb3", threads, args.sb3_steps, "cpu", 0)
+            row["sb3_flush"] = run_child("sb3-flush", threads, args.sb3_steps, "cpu", 0)
+        rows.append(row)
+        o = row["ours"]
         print(
-            f"threads {threads}: bipedal {ours['env_steps_per_s']:.1f} env steps/s "
-            f"({ours['updates_per_s']:.1f} updates/s alone, peak {ours['peak_rss_mb']:.0f} MB); "
-            + (
-                f"sb3-contrib TQC {sb3['env_steps_per_s']:.1f} env steps/s "
-                f"(peak {sb3['peak_rss_mb']:.0f} MB); ratio {ratio}"
-                if sb3
-                else "sb3 skipped"
+            f"threads {threads}: bipedal {o['env_steps_per_s']:.1f} env steps/s "
+            f"({o['updates_per_s']:.1f} updates/s alone, peak {o['peak_rss_mb']:.0f} MB)"
+            + "".join(
+                f"; {name} {row[key]['env_steps_per_s']:.1f} env steps/s"
+                f" (peak {row[key]['peak_rss_mb']:.0f} MB)"
+                for key, name in (("sb3", "sb3-contrib"), ("sb3_flush", "sb3-contrib+flush"))
+                if key in row
             ),
             flush=True,
         )
     print()
-    header = ["threads", "bipedal env steps/s", "bipedal updates/s (alone)"]
-    header += ["sb3-contrib TQC env steps/s", "ratio"]
-    print("| " + " | ".join(header) + " |")
-    print("|---|---|---|---|---|")
+    print(
+        "| threads | bipedal env steps/s | bipedal updates/s (alone) | sb3-contrib TQC "
+        "env steps/s | ratio | sb3-contrib TQC + flush_denormal | ratio |"
+    )
+    print("|---|---|---|---|---|---|---|")
     for r in rows:
-        o, s = r["ours"], r["sb3"]
-        print(
-            f"| {r['threads']} | {o['env_steps_per_s']:.1f} | {o['updates_per_s']:.1f} | "
-            + (
-                f"{s['env_steps_per_s']:.1f} | {o['env_steps_per_s'] / s['env_steps_per_s']:.1f}x |"
-                if s
-                else "- | - |"
-            )
-        )
+        o = r["ours"]["env_steps_per_s"]
+        cells = [str(r["threads"]), f"{o:.1f}", f"{r['ours']['updates_per_s']:.1f}"]
+        for key in ("sb3", "sb3_flush"):
+            if key in r:
+                peer = r[key]["env_steps_per_s"]
+                cells += [f"{peer:.1f}", f"{o / peer:.1f}x"]
+            else:
+                cells += ["-", "-"]
+        print("| " + " | ".join(cells) + " |")
     first = rows[0]["ours"]
     if "eval_s" in first:
         print(

@@ -95,6 +95,9 @@ class TrainConfig:
     """Env steps between training-state checkpoints."""
     threads: int = 0
     """torch intra-op threads; 0 means all cores."""
+    flush_denormal: bool = True
+    """Flush denormal floats to zero on CPU: Adam moments of dead units decay into the denormal
+    range within a few thousand steps and then slow every update down by up to 2x."""
     eval_seed: int = 1_000_000
     """First env seed of evaluation episodes (kept apart from training seeds)."""
 

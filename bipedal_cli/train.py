@@ -107,6 +107,8 @@ class Trainer:
         self.reporter = reporter or NullReporter()
         self.device = resolve_device(cfg.device)
         torch.set_num_threads(cfg.train.threads or os.cpu_count() or 1)
+        # process-wide; see TrainConfig.flush_denormal (measured: benchmarks/throughput.py)
+        torch.set_flush_denormal(cfg.train.flush_denormal)
         torch.manual_seed(cfg.seed)
         self.env = make_env(cfg.env)
         self.obs_dim, self.act_dim = env_dims(self.env)
