@@ -273,7 +273,7 @@ def resolve_config(
 
 
 def validate(cfg: Config, source: str) -> None:
-    a, t = cfg.agent, cfg.train
+    a, t, c = cfg.agent, cfg.train, cfg.curriculum
     checks = [
         (0.0 < a.gamma <= 1.0, "agent.gamma", "a number in (0, 1]"),
         (a.lr > 0, "agent.lr", "a positive number"),
@@ -298,6 +298,9 @@ def validate(cfg: Config, source: str) -> None:
         (t.solved_episodes >= 1, "train.solved_episodes", "a positive integer"),
         (t.checkpoint_every >= 0, "train.checkpoint_every", "a non-negative integer"),
         (t.threads >= 0, "train.threads", "a non-negative integer"),
+        (c.walker_steps >= 0, "curriculum.walker_steps", "a non-negative integer"),
+        (c.hardcore_steps >= 0, "curriculum.hardcore_steps", "a non-negative integer"),
+        (c.replay in REPLAY_CHOICES, "curriculum.replay", "keep or clear"),
         (
             cfg.device in ("auto", "cpu", "cuda") or cfg.device.startswith("cuda:"),
             "device",

@@ -101,6 +101,10 @@ def test_output_errors(tmp_path, trained, capsys):
         (["plot", trained, "--out", tmp_path / "c.jpg"], "--out"),
         (["export", trained, "--out", tmp_path / "p.onnx"], "--out"),
         (["info", tmp_path / "nothing.pt"], "nothing.pt"),
+        (["curriculum", "--replay", "maybe"], "curriculum.replay"),
+        (["record", trained, "--out", tmp_path / "f.mp4", "--fps", 0], "--fps"),
+        (["plot", tmp_path / "nowhere", "--out", tmp_path / "c2.png"], "nowhere"),
+        (["plot", trained, "--metric", "wings", "--out", tmp_path / "c3.png"], "--metric"),
     ]
     for args, needle in cases:
         code, _, err = run_cli(args, capsys)

@@ -44,6 +44,8 @@ def test_env_aliases_and_errors_name_the_key():
         config_from_dict({"train": {"total_steps": "many"}})
     with pytest.raises(UserError, match="'agent.d2rl'.*bool"):
         config_from_dict({"agent": {"d2rl": 1}})
+    with pytest.raises(UserError, match="'curriculum.replay'.*keep or clear"):
+        config_from_dict({"curriculum": {"replay": "maybe"}})
     with pytest.raises(UserError, match="drop_per_critic"):
         config_from_dict({"agent": {"drop_per_critic": 25}})
 
