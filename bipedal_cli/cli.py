@@ -255,10 +255,10 @@ def record(
     scale = scale or (0.5 if gif else 1.0)
     if frame_step < 1 or not 0 < scale <= 4:
         raise UserError("--frame-step/--scale: expected a positive step and a scale in (0, 4]")
-    data, actor, cfg, env_id = _load_policy(ckpt, env)
-    from .envs import make_env
+    import gymnasium
 
-    max_steps = make_env(env_id).spec.max_episode_steps or 2000
+    data, actor, cfg, env_id = _load_policy(ckpt, env)
+    max_steps = gymnasium.spec(env_id).max_episode_steps or 2000
     seeds = list(range(seed, seed + episodes))
     with Progress(
         "[bold]rendering",

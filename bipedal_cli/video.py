@@ -7,7 +7,6 @@ this works on a headless machine and in CI.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 import imageio.v2 as imageio
@@ -15,17 +14,10 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from .envs import is_fall, make_env
+from .evaluation import EpisodeResult
 from .paths import atomic_path
 
 VIDEO_SUFFIXES = (".mp4", ".gif")
-
-
-@dataclass
-class RecordedEpisode:
-    seed: int
-    ret: float
-    length: int
-    fell: bool
 
 
 def caption(frame: np.ndarray, text: str) -> np.ndarray:
@@ -63,7 +55,7 @@ def record(
     frame_step: int = 1,
     scale: float = 1.0,
     on_frame: Callable[[], None] | None = None,
-) -> tuple[list[RecordedEpisode], int, float]:
+) -> tuple[list[EpisodeResult], int, float]:
     """Play one episode per seed and write every ``frame_step``-th frame (scaled) to ``out``.
 
     Returns the episodes, the number of frames written and the frame rate. The file appears
@@ -71,7 +63,7 @@ def record(
     """
     env = make_env(env_id, render=True)
     fps = float(fps or env.metadata.get("render_fps", 50)) / (1 if fps else frame_step)
-    episodes: list[RecordedEpisode] = []
+    episodes: list[EpisodeResult] = []
     frames = 0
     try:
         with atomic_path(out) as tmp, _writer(tmp, fps) as writer:
@@ -98,7 +90,7 @@ def record(
                     length += 1
                     t += 1
                     done = term or trunc
-                episodes.append(RecordedEpisode(seed, ret, length, is_fall(term, r)))
+                episodes.append(EpisodeResult(seed, ret, length, is_fall(term, r)))
     finally:
         env.close()
     return episodes, frames, fps
