@@ -72,15 +72,19 @@ def actor_policy(actor: torch.nn.Module, device: torch.device | str = "cpu"):
     return policy
 
 
+def _cpu_actor(agent_cfg: AgentConfig, dims: tuple[int, int], actor_state: dict):
+    from .agent import make_actor
+
+    actor = make_actor(agent_cfg, *dims)
+    actor.load_state_dict(actor_state)
+    return actor.eval()
+
+
 def _worker(
     agent_cfg: dict, dims: tuple[int, int], actor_state: dict, env_id: str, seeds: list[int]
 ) -> list[EpisodeResult]:
-    from .agent import make_actor
-
     torch.set_num_threads(1)
-    actor = make_actor(AgentConfig(**agent_cfg), *dims)
-    actor.load_state_dict(actor_state)
-    actor.eval()
+    actor = _cpu_actor(AgentConfig(**agent_cfg), dims, actor_state)
     return run_episodes(actor_policy(actor), env_id, seeds)
 
 
@@ -102,26 +106,22 @@ def evaluate_actor(
     workers = workers or min(os.cpu_count() or 1, max(1, len(seeds) // chunk))
     state = {k: v.detach().cpu() for k, v in actor.state_dict().items()}
     dims = (actor.obs_dim, actor.act_dim)
+    chunks = [seeds[i : i + chunk] for i in range(0, len(seeds), chunk)]
     if workers <= 1:
-        cpu_actor = actor if next(actor.parameters()).device.type == "cpu" else None
-        if cpu_actor is None:
-            from .agent import make_actor
-
-            cpu_actor = make_actor(agent_cfg, *dims)
-            cpu_actor.load_state_dict(state)
+        on_cpu = next(actor.parameters()).device.type == "cpu"
+        policy = actor_policy(actor if on_cpu else _cpu_actor(agent_cfg, dims, state))
         results = []
         threads = torch.get_num_threads()
         torch.set_num_threads(1)  # batch-of-5 inference: more threads only contend
         try:
-            for start in range(0, len(seeds), chunk):
-                part = run_episodes(actor_policy(cpu_actor), env_id, seeds[start : start + chunk])
+            for part_seeds in chunks:
+                part = run_episodes(policy, env_id, part_seeds)
                 results += part
                 if on_episodes:
                     on_episodes(len(part))
         finally:
             torch.set_num_threads(threads)
         return results
-    chunks = [seeds[i : i + chunk] for i in range(0, len(seeds), chunk)]
     results_by_chunk: dict[int, list[EpisodeResult]] = {}
     ctx = mp.get_context("spawn")  # fork after torch has started threads can hang
     with ProcessPoolExecutor(workers, mp_context=ctx) as pool:
