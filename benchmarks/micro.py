@@ -4,7 +4,10 @@
 
 1. quantile Huber loss + backward: pairwise (B x N x M x K tensor) against the sorted closed form;
 2. Adam step over the critics' parameters: foreach against fused;
-3. TQC updates/s after 3,000 training steps with and without flushing denormal floats.
+3. sorting the pooled target atoms (64 x 125): torch.sort against NumPy's sort (``sort_rows``);
+4. where one update's time goes: every ATen op timed by category (matrix products, optimizer,
+   sort/search, the rest) against the update's wall time; the difference is Python and autograd;
+5. TQC updates/s after 3,000 training steps with and without flushing denormal floats.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ import numpy as np
 import torch
 
 from bipedal_cli.config import config_from_dict
-from bipedal_cli.losses import quantile_huber_loss, quantile_huber_loss_pairwise
+from bipedal_cli.losses import quantile_huber_loss, quantile_huber_loss_pairwise, sort_rows
 from bipedal_cli.networks import QuantileCritics
 from bipedal_cli.train import Trainer
 
@@ -50,6 +53,77 @@ def adam_timings() -> None:
         print(f"Adam ({kind}) over the critics: {ms:.2f} ms per step")
 
 
+def sort_timings() -> None:
+    x = torch.randn(64, 125)
+    torch_ms = per_call_ms(lambda: torch.sort(x, dim=1), 300)
+    numpy_ms = per_call_ms(lambda: sort_rows(x), 300)
+    print(f"sort (64, 125): torch.sort {torch_ms:.3f} ms, sort_rows (NumPy) {numpy_ms:.3f} ms")
+
+
+def _category(name: str) -> str:
+    if name.startswith(("mm", "bmm", "baddbmm", "addmm", "matmul")):
+        return "matrix products"
+    if name.startswith(("_fused_adam", "_foreach")):
+        return "Adam and Polyak"
+    if name.startswith(("sort", "searchsorted", "gather", "cumsum")):
+        return "sort, search, gather"
+    return "other ops (elementwise, copies, RNG)"
+
+
+def update_breakdown(updates: int = 200) -> None:
+    from torch.utils._python_dispatch import TorchDispatchMode
+
+    from bipedal_cli.agent import TQCAgent
+    from bipedal_cli.config import AgentConfig
+
+    torch.set_flush_denormal(True)  # as in training (train.flush_denormal)
+    torch.manual_seed(0)
+    agent = TQCAgent(AgentConfig(), 24, 4)
+    gen = torch.Generator().manual_seed(0)
+
+    def batch():
+        return {
+            "obs": torch.randn(64, 24, generator=gen),
+            "action": torch.rand(64, 4, generator=gen) * 2 - 1,
+            "reward": torch.randn(64, generator=gen),
+            "next_obs": torch.randn(64, 24, generator=gen),
+            "terminated": torch.zeros(64),
+        }
+
+    batches = [batch() for _ in range(50)]
+    for b in batches:
+        agent.update(b)
+    start = time.perf_counter()
+    for i in range(updates):
+        agent.update(batches[i % 50])
+    plain_ms = (time.perf_counter() - start) / updates * 1e3
+
+    totals: dict[str, float] = {}
+    counts = 0
+
+    class OpTimer(TorchDispatchMode):
+        def __torch_dispatch__(self, func, types, args=(), kwargs=None):
+            nonlocal counts
+            begin = time.perf_counter()
+            out = func(*args, **(kwargs or {}))
+            key = _category(func.__name__)
+            totals[key] = totals.get(key, 0.0) + time.perf_counter() - begin
+            counts += 1
+            return out
+
+    with OpTimer():
+        for i in range(updates):
+            agent.update(batches[i % 50])
+    print(
+        f"one update (batch 64, paper sizes): {plain_ms:.2f} ms; "
+        f"{counts / updates:.0f} ATen ops per update"
+    )
+    for key, seconds in sorted(totals.items(), key=lambda kv: -kv[1]):
+        print(f"  {key:40s} {seconds / updates * 1e3:6.2f} ms")
+    ops_ms = sum(totals.values()) / updates * 1e3
+    print(f"  {'Python, autograd, dispatch (the rest)':40s} {max(plain_ms - ops_ms, 0.0):6.2f} ms")
+
+
 def denormal_timings(steps: int = 3000) -> None:
     cfg = config_from_dict(
         {
@@ -81,6 +155,8 @@ def main() -> None:
     print(f"torch {torch.__version__}, 1 thread")
     loss_timings()
     adam_timings()
+    sort_timings()
+    update_breakdown()
     denormal_timings()
 
 

@@ -38,14 +38,21 @@ def _stage_summary(trainer: Trainer, result: TrainResult, start: dict[str, float
     }
 
 
-def start_curriculum(
+def new_curriculum_trainer(
     cfg: Config, run_dir: str | Path | None = None, reporter: Reporter | None = None
-) -> CurriculumResult:
+) -> Trainer:
+    """A trainer in a new run directory, at stage 1 (BipedalWalker-v3) of the curriculum."""
     cfg.env = STAGES[0]
     run_dir = prepare_new_run_dir(run_dir or default_run_dir(cfg, "curriculum"))
     trainer = Trainer(cfg, run_dir, reporter)
     trainer.curriculum = {"stage": 0, "stage_start": _counters(trainer), "finished": []}
-    return continue_curriculum(trainer)
+    return trainer
+
+
+def start_curriculum(
+    cfg: Config, run_dir: str | Path | None = None, reporter: Reporter | None = None
+) -> CurriculumResult:
+    return continue_curriculum(new_curriculum_trainer(cfg, run_dir, reporter))
 
 
 def _counters(trainer: Trainer) -> dict[str, float]:

@@ -14,6 +14,7 @@ of y and y^2 give it in closed form. :func:`quantile_huber_loss_pairwise` is the
 
 from __future__ import annotations
 
+import numpy as np
 import torch
 
 
@@ -44,11 +45,22 @@ def truncated_target(
     """
     B, N, M = next_atoms.shape
     kept = N * M - drop_per_critic * N
-    pooled, _ = torch.sort(next_atoms.reshape(B, N * M), dim=1)  # (B, N*M)
+    pooled = sort_rows(next_atoms.reshape(B, N * M))  # (B, N*M)
     z = pooled[:, :kept]  # (B, K)
     soft_z = z - alpha * next_log_prob.unsqueeze(1)  # (B, K)
     discount = gamma * (1.0 - terminated.to(z.dtype)).unsqueeze(1)  # (B, 1)
     return reward.unsqueeze(1) + discount * soft_z  # (B, K)
+
+
+def sort_rows(x: torch.Tensor) -> torch.Tensor:
+    """Each row of a (B, L) tensor in ascending order.
+
+    On CPU, for tensors outside autograd, NumPy's vectorised sort: the same values as
+    ``torch.sort`` about 20x faster at (64, 125) (``python benchmarks/micro.py``).
+    """
+    if x.device.type == "cpu" and not x.requires_grad:
+        return torch.from_numpy(np.sort(x.numpy(), axis=1))
+    return torch.sort(x, dim=1).values
 
 
 def quantile_huber_loss_pairwise(atoms: torch.Tensor, target: torch.Tensor) -> torch.Tensor:

@@ -161,6 +161,12 @@ class Trainer:
             "last_eval": self.last_eval,
             "full_eval": self.full_eval,
             "curriculum": self.curriculum,
+            # so that an episode ending right after a resume still logs its losses
+            "update_metrics": (
+                None
+                if self._update_metrics is None
+                else {k: float(v) for k, v in self._update_metrics.items()}
+            ),
         }
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
@@ -180,6 +186,8 @@ class Trainer:
             torch.cuda.set_rng_state_all(state["rng"]["cuda"])
         self.last_eval, self.full_eval = state["last_eval"], state["full_eval"]
         self.curriculum = state.get("curriculum")
+        m = state.get("update_metrics")
+        self._update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
         ep = state["episode"]
         if ep["obs"] is not None:
             self._replay_episode(int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy())
@@ -243,6 +251,10 @@ class Trainer:
         return summary
 
     # ------------------------------------------------------------------ loop
+    def request_stop(self) -> None:
+        """Stop after the current env step, with a checkpoint (what the first Ctrl-C does)."""
+        self._stop_requested = True
+
     def _install_sigint(self):
         if threading.current_thread() is not threading.main_thread():
             return None
@@ -250,7 +262,7 @@ class Trainer:
         def handler(signum, frame):
             if self._stop_requested:  # second Ctrl-C: stop now
                 raise KeyboardInterrupt
-            self._stop_requested = True
+            self.request_stop()
             self.reporter.log("Ctrl-C: saving a checkpoint and stopping (again to abort)")
 
         return signal.signal(signal.SIGINT, handler)

@@ -136,7 +136,7 @@ def test_curriculum_runs_walker_then_hardcore_with_one_agent(tmp_path, capsys):
 
 def test_curriculum_resume_continues_in_the_current_stage(tmp_path):
     from bipedal_cli.config import config_from_dict
-    from bipedal_cli.curriculum import start_curriculum
+    from bipedal_cli.curriculum import continue_curriculum, new_curriculum_trainer, start_curriculum
     from bipedal_cli.train import NullReporter, resume
 
     from .test_train import assert_states_equal
@@ -149,25 +149,14 @@ def test_curriculum_resume_continues_in_the_current_stage(tmp_path):
 
         def update(self, snapshot):
             if snapshot["step"] >= 150:  # stage 2 started at step 120
-                self.trainer._stop_requested = True
+                self.trainer.request_stop()
 
     straight = start_curriculum(config_from_dict(data), tmp_path / "straight")
     assert [s["steps"] for s in straight.stages] == [120, 80]
 
     reporter = StopInStageTwo()
-    import bipedal_cli.curriculum as cur
-
-    original = cur.Trainer
-
-    def capture(*args, **kwargs):
-        reporter.trainer = original(*args, **kwargs)
-        return reporter.trainer
-
-    cur.Trainer = capture
-    try:
-        cut = start_curriculum(config_from_dict(data), tmp_path / "cut", reporter)
-    finally:
-        cur.Trainer = original
+    reporter.trainer = new_curriculum_trainer(config_from_dict(data), tmp_path / "cut", reporter)
+    cut = continue_curriculum(reporter.trainer)
     assert cut.stopped == "interrupted" and [s["env"] for s in cut.stages] == ["BipedalWalker-v3"]
     mid = load_checkpoint(tmp_path / "cut" / "state.pt")
     assert mid["curriculum"]["stage"] == 1 and mid["env"] == "BipedalWalkerHardcore-v3"

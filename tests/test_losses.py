@@ -141,3 +141,15 @@ def test_temperature_loss_matches_reference_and_moves_alpha_the_right_way():
     # Entropy estimate -log pi = -0.5 on average, above H_T = -4: dJ/dlog(alpha) = 3.5 > 0, so
     # gradient descent lowers alpha.
     assert log_alpha.grad.item() == pytest.approx(3.5, rel=1e-12)
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_sort_rows_matches_torch_sort(dtype):
+    from bipedal_cli.losses import sort_rows
+
+    gen = torch.Generator().manual_seed(3)
+    x = torch.randint(-20, 20, (64, 125), generator=gen).to(dtype) / 4  # many ties
+    assert torch.equal(sort_rows(x), torch.sort(x, dim=1).values)
+    assert sort_rows(x).dtype == dtype
+    g = x.clone().requires_grad_(True)  # inside autograd: torch.sort's path
+    assert torch.equal(sort_rows(g), torch.sort(x, dim=1).values)
