@@ -83,7 +83,7 @@ class TrainConfig:
     """Replay buffer capacity in transitions."""
     updates_per_step: int = 1
     """Gradient steps per env step after warm-up (UTD ratio)."""
-    eval_every: int = 10_000
+    eval_every: int = 5_000
     """Env steps between periodic deterministic evaluations (0: never)."""
     eval_episodes: int = 5
     """Episodes per periodic evaluation."""

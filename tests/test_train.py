@@ -108,3 +108,17 @@ def test_new_run_refuses_an_existing_run_dir(tmp_path):
     train(config_from_dict(tiny_dict(total_steps=20)), tmp_path / "run")
     with pytest.raises(UserError, match="already holds a run"):
         train(config_from_dict(tiny_dict(total_steps=20)), tmp_path / "run")
+
+
+def test_evaluations_do_not_change_the_training_trajectory(tmp_path):
+    # Evaluation uses its own envs and the deterministic policy: how often it runs must not
+    # move any RNG, so runs with different train.eval_every are the same run.
+    a = train(config_from_dict(tiny_dict(total_steps=300, eval_every=0)), tmp_path / "a")
+    b = train(config_from_dict(tiny_dict(total_steps=300, eval_every=100)), tmp_path / "b")
+    sa, sb = (load_checkpoint(r.run_dir / "state.pt") for r in (a, b))
+    assert a.episodes == b.episodes
+    ignore = ("path", "config", "last_eval", "full_eval")
+    assert_states_equal(
+        {k: v for k, v in sa.items() if k not in ignore},
+        {k: v for k, v in sb.items() if k not in ignore},
+    )
