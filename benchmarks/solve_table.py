@@ -63,13 +63,28 @@ def main() -> None:
             f"{r['minutes']:.1f} | {r['full_eval']} | {r['best_eval']} |"
         )
     solved = [r for r in results if r["solved"]]
-    if solved:
-        for key, label in (("steps", "env steps"), ("episodes", "episodes"), ("minutes", "min")):
+    print(f"solved {len(solved)} of {len(results)}")
+    for key, label in (("steps", "env steps"), ("episodes", "episodes"), ("minutes", "min")):
+        print(f"{label} to solve, median over all runs: {censored_median(results, key)}", end="")
+        if solved:
             values = [r[key] for r in solved]
-            print(
-                f"solved {len(solved)} of {len(results)}; {label}: median "
-                f"{statistics.median(values):,.1f}, range {min(values):,.1f}-{max(values):,.1f}"
-            )
+            print(f"; range of the solved runs {min(values):,.1f}-{max(values):,.1f}", end="")
+        print()
+
+
+def censored_median(results: list[dict], key: str) -> str:
+    """The median over every run, a run that did not solve counting as "more than it reached".
+
+    Leaving unsolved runs out would flatter the median; when the middle of the sorted runs is an
+    unsolved one, the median is only known to exceed what that run reached: "> X".
+    """
+    ordered = sorted(results, key=lambda r: (not r["solved"], r[key] if r["solved"] else 0))
+    n = len(ordered)
+    middle = ordered[(n - 1) // 2 : n // 2 + 1]  # one run (n odd) or two (n even)
+    if all(r["solved"] for r in middle):
+        return f"{statistics.mean(r[key] for r in middle):,.1f}"
+    # the unsolved value is a lower bound, so the mean of the middle pair is one too
+    return f"> {statistics.mean(r[key] for r in middle):,.1f}"
 
 
 if __name__ == "__main__":

@@ -12,16 +12,22 @@ def test_default_yaml_equals_the_dataclass_defaults():
     assert resolve_config(CONFIGS / "walker.yaml") == Config()
 
 
-@pytest.mark.parametrize("name", ["walker", "hardcore", "mlp-ablation", "curriculum"])
+@pytest.mark.parametrize("name", ["walker", "paper", "hardcore", "mlp-ablation", "curriculum"])
 def test_shipped_configs_load(name):
+    # paper.yaml is walker.yaml but for the learning rate
+    if name == "paper":
+        paper, walker = resolve_config(CONFIGS / "paper.yaml"), Config()
+        assert paper.agent.lr == pytest.approx(3.296e-4) and walker.agent.lr == 7.3e-4
+        paper.agent.lr = walker.agent.lr
+        assert paper == walker
     path = CONFIGS / f"{name}.yaml"
     if not path.exists():
         pytest.skip(f"{path.name} not shipped")
     resolve_config(path)
 
 
-def test_table1_modes_and_mean_learning_rate():
-    cfg = Config()
+def test_paper_config_is_table1_modes_and_mean_learning_rate():
+    cfg = resolve_config(CONFIGS / "paper.yaml")
     lrs = [0.000302, 0.0003, 0.000465, 0.000273, 0.000308]
     assert cfg.agent.lr == pytest.approx(sum(lrs) / 5)
     assert (cfg.agent.gamma, cfg.agent.batch_size, cfg.train.buffer_size) == (0.98, 64, 1_000_000)

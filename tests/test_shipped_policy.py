@@ -28,3 +28,14 @@ def test_shipped_policy_solves_its_first_evaluation_episodes():
         assert not got.fell and got.ret > 300
         # same chunk of 5 as `bipedal eval`: equal here, within a point on another CPU
         assert got.ret == pytest.approx(want["ret"], abs=1.0)
+
+
+@pytest.mark.skipif(not POLICY.exists(), reason="no shipped policy")
+def test_shipped_policy_was_trained_with_the_committed_default_config():
+    from bipedal_cli.config import resolve_config
+
+    _, trained = actor_from_checkpoint(load_checkpoint(POLICY))
+    default = resolve_config(ROOT / "configs" / "walker.yaml")
+    trained.train.threads = default.train.threads  # the thread count is not a hyperparameter
+    trained.seed = default.seed
+    assert trained == default
