@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -99,6 +99,12 @@ def plot_runs(
     if labels and len(labels) != len(run_dirs):
         raise UserError(f"--label: given {len(labels)} labels for {len(run_dirs)} runs")
     curves = [load_run(d, labels[i] if labels else None, metric) for i, d in enumerate(run_dirs)]
+    # alpha spans decades: its statistics are taken in log space (a geometric mean and a band of
+    # x/÷ one geometric std), so that the band stays positive on the log axis
+    log_space = metric == "alpha"
+    if log_space:
+        curves = [replace(c, values=np.log(np.maximum(c.values, 1e-30))) for c in curves]
+    back = np.exp if log_space else (lambda v: v)
     fig, ax = plt.subplots(figsize=(8, 4.8), dpi=110)
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     groups: dict[str, list[RunCurve]] = {}
@@ -111,13 +117,13 @@ def plot_runs(
         label = key.split("#")[0]
         if len(members) > 1:
             grid, mean, std = aggregate(members)
-            ax.plot(grid, mean, color=color, label=f"{label} (mean of {len(members)} runs)")
-            ax.fill_between(grid, mean - std, mean + std, color=color, alpha=0.2)
+            ax.plot(grid, back(mean), color=color, label=f"{label} (mean of {len(members)} runs)")
+            ax.fill_between(grid, back(mean - std), back(mean + std), color=color, alpha=0.2)
         else:
             c = members[0]
             mean, std = moving_stats(c.values)
-            ax.plot(c.steps, mean, color=color, label=f"{label}")
-            ax.fill_between(c.steps, mean - std, mean + std, color=color, alpha=0.2)
+            ax.plot(c.steps, back(mean), color=color, label=f"{label}")
+            ax.fill_between(c.steps, back(mean - std), back(mean + std), color=color, alpha=0.2)
         for c in members:
             if len(c.eval_steps):
                 ax.scatter(
@@ -149,7 +155,11 @@ def plot_runs(
         ax.set_yscale("log")
     ax.set_xlabel("env steps")
     ax.set_ylabel("episode return" if metric == "return" else f"{metric} (at episode end)")
-    default_title = "moving mean over 10 episodes (band: +-1 std)"
+    default_title = (
+        "moving geometric mean over 10 episodes (band: x/÷ 1 geometric std)"
+        if log_space
+        else "moving mean over 10 episodes (band: +-1 std)"
+    )
     if metric == "return":
         default_title += "; points: evaluations"
     ax.set_title(title or default_title)
