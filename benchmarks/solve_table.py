@@ -78,7 +78,7 @@ def censored_median(results: list[dict], key: str) -> str:
     Leaving unsolved runs out would flatter the median; when the middle of the sorted runs is an
     unsolved one, the median is only known to exceed what that run reached: "> X".
     """
-    ordered = sorted(results, key=lambda r: (not r["solved"], r[key] if r["solved"] else 0))
+    ordered = sorted(results, key=lambda r: (not r["solved"], r[key]))  # unsolved runs last
     n = len(ordered)
     middle = ordered[(n - 1) // 2 : n // 2 + 1]  # one run (n odd) or two (n even)
     if all(r["solved"] for r in middle):

@@ -41,8 +41,9 @@ class AgentConfig:
 
     gamma: float = 0.98
     """Discount factor."""
-    lr: float = 7.3e-4  # rl-zoo's; Table 1's mean 3.296e-4 is configs/paper.yaml
-    """Adam learning rate for actor, critics and temperature."""
+    lr: float = 7.3e-4
+    """Adam learning rate for actor, critics and temperature (rl-zoo's for this env; Table 1's
+    mean, 3.296e-4, is configs/paper.yaml; docs/tuning.md compares them)."""
     batch_size: int = 64
     """Transitions per gradient step."""
     tau: float = 0.005
