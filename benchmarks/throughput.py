@@ -74,7 +74,6 @@ def measure_ours(threads: int, steps: int, device: str, eval_episodes: int) -> d
 
     clock = Clock()
     trainer = Trainer(cfg, tempfile.mkdtemp(prefix="bipedal-bench-"), clock)
-    torch.set_num_threads(threads)
     trainer.run(total_steps=WARMUP + 100 + steps)
     timed = [(s, t) for s, t in clock.marks if s >= WARMUP + 100]
     (s0, t0), (s1, t1) = timed[0], timed[-2]  # the last mark comes after the final save

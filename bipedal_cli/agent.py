@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import copy
+import threading
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import torch
@@ -18,6 +20,25 @@ def make_actor(cfg: AgentConfig, obs_dim: int, act_dim: int) -> SquashedGaussian
     )
 
 
+class _Handoff:
+    """One value passed from the calling thread to the worker within an update."""
+
+    def __init__(self) -> None:
+        self._ready = threading.Event()
+        self._value = None
+
+    def put(self, value) -> None:
+        if not self._ready.is_set():
+            self._value = value
+            self._ready.set()
+
+    def get(self):
+        self._ready.wait()
+        if self._value is None:
+            raise RuntimeError("the actor's part of the update failed before sampling a'")
+        return self._value
+
+
 class TQCAgent:
     """Holds the learner's state; :meth:`update` is one gradient step of TQC (Kuznetsov 2020)."""
 
@@ -25,6 +46,7 @@ class TQCAgent:
         self, cfg: AgentConfig, obs_dim: int, act_dim: int, device: torch.device | str = "cpu"
     ) -> None:
         self.cfg, self.obs_dim, self.act_dim = cfg, obs_dim, act_dim
+        self._worker: ThreadPoolExecutor | None = None
         self.device = torch.device(device)
         self.actor = make_actor(cfg, obs_dim, act_dim).to(self.device)
         self.critic = QuantileCritics(
@@ -52,6 +74,23 @@ class TQCAgent:
         self._online = list(self.critic.parameters())
         self._target = list(self.critic_target.parameters())
 
+    def start_worker(self, flush_denormal: bool = True) -> None:
+        """Run the critics' half of every update on a second thread (CPU, 2+ cores).
+
+        Meant for one intra-op thread per half: ``torch.set_num_threads(1)``; batch-64 matrix
+        products split badly across cores, two independent halves split well. Denormal
+        flushing is a per-thread CPU flag, so the worker sets its own.
+        """
+        if self._worker is None:
+            self._worker = ThreadPoolExecutor(
+                1, "tqc-critic", initializer=torch.set_flush_denormal, initargs=(flush_denormal,)
+            )
+
+    def stop_worker(self) -> None:
+        if self._worker is not None:
+            self._worker.shutdown()
+            self._worker = None
+
     # ------------------------------------------------------------------ acting
     @torch.no_grad()
     def act(self, obs: np.ndarray, deterministic: bool = False) -> np.ndarray:
@@ -71,57 +110,119 @@ class TQCAgent:
         return {k: torch.as_tensor(v, device=self.device) for k, v in batch.items()}
 
     def update(self, batch: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
-        """One TQC step on a batch; returns detached 0-dim metric tensors (no host sync here)."""
-        cfg = self.cfg
-        obs, action, reward = batch["obs"], batch["action"], batch["reward"]
-        next_obs, terminated = batch["next_obs"], batch["terminated"]
-        alpha = self.log_alpha.detach().exp()
+        """One TQC step on a batch; returns detached 0-dim metric tensors (no host sync here).
 
-        # --- critic loss (eq. 1) against the truncated target ---
+        As in the paper's algorithm (and the TQC authors' code), the three gradients
+        grad J_Z(psi), grad J_pi(phi) and grad J(alpha) are all taken at the current
+        parameters; then every parameter moves. The critics' part (target, eq. 1, Adam,
+        Polyak) and the actor's part (eqs. 2-3, Adam) meet in two places only: the target
+        needs a' ~ pi(.|s') from the actor before the actor's step, and the actor loss reads
+        the critics before the critics' step. With a worker thread (:meth:`start_worker`) the
+        critics' part runs there and the actor's part on the calling thread (ATen releases
+        the GIL inside each op); two events order those reads before the writes, so the
+        result is the same to the bit as without the worker.
+        """
+        obs, next_obs = batch["obs"], batch["next_obs"]
+        # (2, B, A): eps[0] draws a ~ pi(.|s) for eqs. 2-3, eps[1] a' ~ pi(.|s') for the target
+        eps = torch.randn(
+            (2, obs.shape[0], self.act_dim),
+            generator=self.noise,
+            device=self.device,
+            dtype=obs.dtype,
+        )
+        alpha = self.log_alpha.detach().exp()
+        if self._worker is None:
+            next_sample = _Handoff()
+            next_sample.put(self._next_action(next_obs, eps[1]))
+            critic_metrics = self._critic_gradients(batch, alpha, next_sample)
+            actor_metrics = self._actor_gradients(obs, eps[0], alpha)
+            self._critic_step()
+            self._actor_step()
+        else:
+            next_sample, actor_loss_done = _Handoff(), threading.Event()
+            job = self._worker.submit(self._critic_part, batch, alpha, next_sample, actor_loss_done)
+            try:
+                next_sample.put(self._next_action(next_obs, eps[1]))
+                actor_metrics = self._actor_gradients(obs, eps[0], alpha)
+            finally:
+                next_sample.put(None)  # never leave the worker waiting, even after an error
+                actor_loss_done.set()
+            self._actor_step()
+            critic_metrics = job.result()
+        self.updates += 1
+        return {**critic_metrics, **actor_metrics, "alpha": alpha}
+
+    @torch.no_grad()
+    def _next_action(
+        self, next_obs: torch.Tensor, eps: torch.Tensor
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """a' ~ pi(.|s') and log pi(a'|s') for the target, (B, A) and (B,)."""
+        return self.actor.sample(next_obs, eps=eps)
+
+    def _critic_gradients(
+        self, batch: dict[str, torch.Tensor], alpha: torch.Tensor, next_sample: _Handoff
+    ) -> dict[str, torch.Tensor]:
+        """grad J_Z(psi) of eq. (1) against the truncated target, into the critics' .grad."""
+        cfg = self.cfg
+        atoms = self.critic(batch["obs"], batch["action"])  # (B, N, M)
+        next_action, next_log_prob = next_sample.get()  # (B, A), (B,)
         with torch.no_grad():
-            next_action, next_log_prob = self.actor.sample(next_obs, generator=self.noise)
-            next_atoms = self.critic_target(next_obs, next_action)  # (B, N, M)
+            next_atoms = self.critic_target(batch["next_obs"], next_action)  # (B, N, M)
             target = truncated_target(
                 next_atoms,
-                reward,
-                terminated,
+                batch["reward"],
+                batch["terminated"],
                 next_log_prob,
                 alpha,
                 cfg.gamma,
                 cfg.drop_per_critic,
             )  # (B, K)
-        atoms = self.critic(obs, action)  # (B, N, M)
         critic_loss = quantile_huber_loss(atoms, target)
         self.critic_opt.zero_grad(set_to_none=True)
         critic_loss.backward()
-        self.critic_opt.step()
+        return {"critic_loss": critic_loss.detach(), "q_mean": atoms.detach().mean()}
 
-        # --- actor loss (eq. 2) through the just-updated critics, weights frozen ---
-        new_action, log_prob = self.actor.sample(obs, generator=self.noise)
+    def _critic_step(self) -> None:
+        """Adam on the critics, then Polyak: psi_bar <- tau psi + (1 - tau) psi_bar."""
+        self.critic_opt.step()
+        with torch.no_grad():
+            torch._foreach_lerp_(self._target, self._online, self.cfg.tau)
+
+    def _critic_part(
+        self,
+        batch: dict[str, torch.Tensor],
+        alpha: torch.Tensor,
+        next_sample: _Handoff,
+        actor_loss_done: threading.Event,
+    ) -> dict[str, torch.Tensor]:
+        """The worker thread's share of :meth:`update`."""
+        metrics = self._critic_gradients(batch, alpha, next_sample)
+        actor_loss_done.wait()  # the actor loss has read the critics' weights (backward too)
+        self._critic_step()
+        return metrics
+
+    def _actor_gradients(
+        self, obs: torch.Tensor, eps: torch.Tensor, alpha: torch.Tensor
+    ) -> dict[str, torch.Tensor]:
+        """grad J_pi(phi) of eq. (2) through the critics (their weights frozen), grad J(alpha)
+        of eq. (3)."""
+        new_action, log_prob = self.actor.sample(obs, eps=eps)  # (B, A), (B,)
         new_atoms = self.critic(obs, new_action, detach_params=True)  # (B, N, M)
         pi_loss = actor_loss(log_prob, new_atoms, alpha)
         self.actor_opt.zero_grad(set_to_none=True)
         pi_loss.backward()
-        self.actor_opt.step()
-
-        # --- temperature loss (eq. 3) ---
         alpha_loss = temperature_loss(self.log_alpha, log_prob, self.target_entropy)
         self.alpha_opt.zero_grad(set_to_none=True)
         alpha_loss.backward()
-        self.alpha_opt.step()
-
-        # --- Polyak averaging of the target critics: psi_bar <- tau psi + (1 - tau) psi_bar ---
-        with torch.no_grad():
-            torch._foreach_lerp_(self._target, self._online, cfg.tau)
-        self.updates += 1
         return {
-            "critic_loss": critic_loss.detach(),
             "actor_loss": pi_loss.detach(),
             "alpha_loss": alpha_loss.detach(),
-            "alpha": alpha,
             "entropy": -log_prob.detach().mean(),
-            "q_mean": atoms.detach().mean(),
         }
+
+    def _actor_step(self) -> None:
+        self.actor_opt.step()
+        self.alpha_opt.step()
 
     # ------------------------------------------------------------- persistence
     def state_dict(self) -> dict:

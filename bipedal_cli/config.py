@@ -95,7 +95,12 @@ class TrainConfig:
     checkpoint_every: int = 10_000
     """Env steps between training-state checkpoints."""
     threads: int = 0
-    """torch intra-op threads; 0 means all cores."""
+    """CPU threads for training; 0 means all cores. With 2 or more (on CPU, with
+    ``split_update``) each update runs its critics' and actor's parts on two threads with
+    threads // 2 intra-op threads each; the result equals a 1-thread run's to the bit."""
+    split_update: bool = True
+    """Run the critics' and the actor's parts of each update concurrently when threads >= 2
+    (batch-64 matrix products split badly across cores; the two parts split well)."""
     flush_denormal: bool = True
     """Flush denormal floats to zero on CPU: Adam moments of dead units decay into the denormal
     range within a few thousand steps and then slow every update down by up to 2x."""

@@ -133,11 +133,21 @@ class SquashedGaussianActor(nn.Module):
         return self.deterministic(obs)
 
     def sample(
-        self, obs: torch.Tensor, generator: torch.Generator | None = None
+        self,
+        obs: torch.Tensor,
+        generator: torch.Generator | None = None,
+        eps: torch.Tensor | None = None,
     ) -> tuple[torch.Tensor, torch.Tensor]:
-        """Reparameterised sample a = tanh(mu + sigma * eps) and log pi(a|s), (B, A) and (B,)."""
+        """Reparameterised sample a = tanh(mu + sigma * eps) and log pi(a|s), (B, A) and (B,).
+
+        eps ~ N(0, I), (B, A), is drawn from ``generator`` unless given (the agent draws the
+        noise of a whole update up front, so that its two halves can run in two threads).
+        """
         mean, log_std = self.distribution_params(obs)
-        eps = torch.randn(mean.shape, generator=generator, device=mean.device, dtype=mean.dtype)
+        if eps is None:
+            eps = torch.randn(
+                mean.shape, generator=generator, device=mean.device, dtype=mean.dtype
+            )
         u = mean + log_std.exp() * eps
         return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std)
 

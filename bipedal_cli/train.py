@@ -106,13 +106,17 @@ class Trainer:
         self.run_dir = Path(run_dir)
         self.reporter = reporter or NullReporter()
         self.device = resolve_device(cfg.device)
-        torch.set_num_threads(cfg.train.threads or os.cpu_count() or 1)
+        threads = cfg.train.threads or os.cpu_count() or 1
+        split = cfg.train.split_update and self.device.type == "cpu" and threads >= 2
+        torch.set_num_threads(threads // 2 if split else threads)  # per part when split
         # process-wide; see TrainConfig.flush_denormal (measured: benchmarks/throughput.py)
         torch.set_flush_denormal(cfg.train.flush_denormal)
         torch.manual_seed(cfg.seed)
         self.env = make_env(cfg.env)
         self.obs_dim, self.act_dim = env_dims(self.env)
         self.agent = TQCAgent(cfg.agent, self.obs_dim, self.act_dim, self.device)
+        if split:
+            self.agent.start_worker(cfg.train.flush_denormal)
         self.agent.noise.manual_seed(cfg.seed + 1)
         self.buffer = ReplayBuffer(cfg.train.buffer_size, self.obs_dim, self.act_dim)
         self.rng = np.random.default_rng(cfg.seed)

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import torch
 import yaml
+from PIL import Image, ImageSequence
 
 from bipedal_cli.checkpoint import actor_from_checkpoint, load_checkpoint
 
@@ -52,7 +53,12 @@ def test_record_gif_is_downscaled_and_subsampled(tmp_path, trained, capsys):
         if line.startswith("episode seed")
     ]
     assert len(lengths) == 2
-    assert len(frames) == sum(n // 2 + 1 for n in lengths)
+    # Every 2nd frame at 25 fps (40 ms each). Pillow merges identical consecutive frames into
+    # one with their durations added, so count playing time, not frames.
+    with Image.open(out) as gif:
+        durations = [frame.info["duration"] for frame in ImageSequence.Iterator(gif)]
+    assert len(frames) == len(durations) <= sum(n // 2 + 1 for n in lengths)
+    assert sum(durations) == pytest.approx(40 * sum(n // 2 + 1 for n in lengths))
 
 
 def test_plot_overlays_runs_and_train_wrote_its_own(tmp_path, trained, capsys):

@@ -26,8 +26,10 @@ def test_shipped_policy_solves_its_first_evaluation_episodes():
     for got, want in zip(episodes, recorded["episodes"][:5], strict=True):
         assert got.seed == want["seed"]
         assert not got.fell and got.ret > 300
-        # same chunk of 5 as `bipedal eval`: equal here, within a point on another CPU
-        assert got.ret == pytest.approx(want["ret"], abs=1.0)
+        # Same chunk of 5 as `bipedal eval`: equal on the machine that wrote the report. On
+        # another CPU the float rounding of the matrix products differs and a 1,600-step walk
+        # amplifies it (seen: 304.2 against 305.6 on an AMD EPYC for an Intel Xeon's report).
+        assert got.ret == pytest.approx(want["ret"], rel=0.02)
 
 
 @pytest.mark.skipif(not POLICY.exists(), reason="no shipped policy")

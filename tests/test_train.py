@@ -122,3 +122,18 @@ def test_evaluations_do_not_change_the_training_trajectory(tmp_path):
         {k: v for k, v in sa.items() if k not in ignore},
         {k: v for k, v in sb.items() if k not in ignore},
     )
+
+
+def test_two_threads_give_the_one_thread_run_bit_for_bit(tmp_path):
+    # threads=2 splits every update over two threads of one intra-op thread each; the order of
+    # every floating-point operation stays that of a threads=1 run.
+    one = train(config_from_dict(tiny_dict(total_steps=250, threads=1)), tmp_path / "one")
+    two = train(config_from_dict(tiny_dict(total_steps=250, threads=2)), tmp_path / "two")
+    torch.set_num_threads(1)
+    assert one.episodes == two.episodes
+    sa, sb = (load_checkpoint(r.run_dir / "state.pt") for r in (one, two))
+    ignore = ("path", "config")
+    assert_states_equal(
+        {k: v for k, v in sa.items() if k not in ignore},
+        {k: v for k, v in sb.items() if k not in ignore},
+    )
