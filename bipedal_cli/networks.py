@@ -145,9 +145,7 @@ class SquashedGaussianActor(nn.Module):
         """
         mean, log_std = self.distribution_params(obs)
         if eps is None:
-            eps = torch.randn(
-                mean.shape, generator=generator, device=mean.device, dtype=mean.dtype
-            )
+            eps = torch.randn(mean.shape, generator=generator, device=mean.device, dtype=mean.dtype)
         u = mean + log_std.exp() * eps
         return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std)
 
