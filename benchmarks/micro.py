@@ -7,7 +7,8 @@
 3. sorting the pooled target atoms (64 x 125): torch.sort against NumPy's sort (``sort_rows``);
 4. where one update's time goes: every ATen op timed by category (matrix products, optimizer,
    sort/search, the rest) against the update's wall time; the difference is Python and autograd;
-5. TQC updates/s after 3,000 training steps with and without flushing denormal floats.
+5. the matrix products' floor: an update's FLOPs over one core's large-product GFLOP/s;
+6. TQC updates/s after 3,000 training steps with and without flushing denormal floats.
 """
 
 from __future__ import annotations
@@ -124,6 +125,40 @@ def update_breakdown(updates: int = 200) -> None:
     print(f"  {'Python, autograd, dispatch (the rest)':40s} {max(plain_ms - ops_ms, 0.0):6.2f} ms")
 
 
+def matmul_floor(updates: int = 20) -> None:
+    """The least time an update's matrix products can take on one core of this CPU.
+
+    FLOPs of one update counted by ``FlopCounterMode`` (every mm/bmm/baddbmm, forward and
+    backward), over the GFLOP/s of one large single-thread product (1024^3), which batch-64
+    products do not beat.
+    """
+    from torch.utils.flop_counter import FlopCounterMode
+
+    from bipedal_cli.agent import TQCAgent
+    from bipedal_cli.config import AgentConfig
+
+    torch.manual_seed(0)
+    agent = TQCAgent(AgentConfig(), 24, 4)
+    batch = {
+        "obs": torch.randn(64, 24),
+        "action": torch.rand(64, 4) * 2 - 1,
+        "reward": torch.randn(64),
+        "next_obs": torch.randn(64, 24),
+        "terminated": torch.zeros(64),
+    }
+    counter = FlopCounterMode(display=False)
+    with counter:
+        agent.update(batch)
+    flops = counter.get_total_flops()
+    a, b = torch.randn(1024, 1024), torch.randn(1024, 1024)
+    ms = per_call_ms(lambda: a @ b, updates)
+    peak = 2 * 1024**3 / (ms / 1e3) / 1e9
+    print(
+        f"matrix products: {flops / 1e6:.0f} MFLOP per update; one core does {peak:.0f} GFLOP/s "
+        f"on a 1024^3 product, so they need at least {flops / peak / 1e6:.2f} ms per update"
+    )
+
+
 def denormal_timings(steps: int = 3000) -> None:
     cfg = config_from_dict(
         {
@@ -157,6 +192,7 @@ def main() -> None:
     adam_timings()
     sort_timings()
     update_breakdown()
+    matmul_floor()
     denormal_timings()
 
 

@@ -9,6 +9,10 @@ implementations use 5 critics x 25 quantiles (drop 2 per net), critics 2 x 256, 
 batch 64, one gradient step per env step, gamma 0.98, 1,000 random warm-up steps that are not
 timed. "env steps/s" is full training after warm-up: env step, replay buffer, gradient step.
 sb3's networks are plain MLPs; ours are D2RL (slightly more work per layer).
+
+With 2 threads bipedal splits each update into the critics' and the actor's parts, run on two
+threads (``train.split_update``); the "update not split" figure is the same code with the split
+off (both threads used inside each op instead), to show what the split gains.
 """
 
 from __future__ import annotations
@@ -41,7 +45,7 @@ def peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
-def measure_ours(threads: int, steps: int, device: str, eval_episodes: int) -> dict:
+def measure_ours(threads: int, steps: int, device: str, eval_episodes: int, split: bool) -> dict:
     import numpy as np
     import torch
 
@@ -57,6 +61,7 @@ def measure_ours(threads: int, steps: int, device: str, eval_episodes: int) -> d
                 "eval_every": 0,
                 "checkpoint_every": 0,
                 "threads": threads,
+                "split_update": split,
                 "buffer_size": 100_000,
             },
         }
@@ -152,8 +157,9 @@ def measure_sb3(threads: int, steps: int, flush_denormal: bool) -> dict:
 
 
 def child(args) -> None:
-    if args.impl == "ours":
-        out = measure_ours(args.threads, args.steps, args.device, args.eval_episodes)
+    if args.impl in ("ours", "ours-unsplit"):
+        split = args.impl == "ours"
+        out = measure_ours(args.threads, args.steps, args.device, args.eval_episodes, split)
     else:
         out = measure_sb3(args.threads, args.steps, args.child == "sb3-flush")
     print("RESULT " + json.dumps(out))
@@ -191,7 +197,9 @@ def main() -> None:
     parser.add_argument("--eval-episodes", type=int, default=100)
     parser.add_argument("--skip-sb3", action="store_true")
     parser.add_argument("--json", help="also write the results here")
-    parser.add_argument("--child", choices=["ours", "sb3", "sb3-flush"], help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--child", choices=["ours", "ours-unsplit", "sb3", "sb3-flush"], help=argparse.SUPPRESS
+    )
     args = parser.parse_args()
     if args.child:
         args.impl = args.child
@@ -208,6 +216,8 @@ def main() -> None:
         eval_episodes = args.eval_episodes if threads == args.threads[0] else 0
         row = {"threads": threads}
         row["ours"] = run_child("ours", threads, args.steps, args.device, eval_episodes)
+        if threads >= 2 and args.device == "cpu":  # what splitting each update gains
+            row["ours_unsplit"] = run_child("ours-unsplit", threads, args.steps, "cpu", 0)
         if not args.skip_sb3:
             # as shipped, and with the same denormal flushing we use (a one-line change for them)
             row["sb3"] = run_child("sb3", threads, args.sb3_steps, "cpu", 0)
@@ -220,20 +230,30 @@ def main() -> None:
             + "".join(
                 f"; {name} {row[key]['env_steps_per_s']:.1f} env steps/s"
                 f" (peak {row[key]['peak_rss_mb']:.0f} MB)"
-                for key, name in (("sb3", "sb3-contrib"), ("sb3_flush", "sb3-contrib+flush"))
+                for key, name in (
+                    ("ours_unsplit", "bipedal with the update not split"),
+                    ("sb3", "sb3-contrib"),
+                    ("sb3_flush", "sb3-contrib+flush"),
+                )
                 if key in row
             ),
             flush=True,
         )
     print()
     print(
-        "| threads | bipedal env steps/s | bipedal updates/s (alone) | sb3-contrib TQC "
-        "env steps/s | ratio | sb3-contrib TQC + flush_denormal | ratio |"
+        "| threads | bipedal env steps/s | bipedal updates/s (alone) | bipedal, update not "
+        "split | sb3-contrib TQC env steps/s | ratio | sb3-contrib TQC + flush_denormal | ratio |"
     )
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for r in rows:
         o = r["ours"]["env_steps_per_s"]
         cells = [str(r["threads"]), f"{o:.1f}", f"{r['ours']['updates_per_s']:.1f}"]
+        unsplit = r.get("ours_unsplit")
+        cells.append(
+            f"{unsplit['env_steps_per_s']:.1f} ({unsplit['updates_per_s']:.1f} updates/s)"
+            if unsplit
+            else "-"
+        )
         for key in ("sb3", "sb3_flush"):
             if key in r:
                 peer = r[key]["env_steps_per_s"]

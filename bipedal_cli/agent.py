@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import copy
 import threading
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Iterator, Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 import torch
@@ -20,23 +21,26 @@ def make_actor(cfg: AgentConfig, obs_dim: int, act_dim: int) -> SquashedGaussian
     )
 
 
-class _Handoff:
-    """One value passed from the calling thread to the worker within an update."""
+class _MetricsWhenDone(Mapping):
+    """An update's metrics, of which the critics' arrive when the worker finishes its part."""
 
-    def __init__(self) -> None:
-        self._ready = threading.Event()
-        self._value = None
+    def __init__(self, critic_job: Future, actor_metrics: dict[str, torch.Tensor]) -> None:
+        self._job, self._actor_metrics = critic_job, actor_metrics
+        self._all: dict[str, torch.Tensor] | None = None
 
-    def put(self, value) -> None:
-        if not self._ready.is_set():
-            self._value = value
-            self._ready.set()
+    def _resolved(self) -> dict[str, torch.Tensor]:
+        if self._all is None:
+            self._all = {**self._job.result(), **self._actor_metrics}
+        return self._all
 
-    def get(self):
-        self._ready.wait()
-        if self._value is None:
-            raise RuntimeError("the actor's part of the update failed before sampling a'")
-        return self._value
+    def __getitem__(self, key: str) -> torch.Tensor:
+        return self._resolved()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._resolved())
+
+    def __len__(self) -> int:
+        return len(self._resolved())
 
 
 class TQCAgent:
@@ -47,6 +51,7 @@ class TQCAgent:
     ) -> None:
         self.cfg, self.obs_dim, self.act_dim = cfg, obs_dim, act_dim
         self._worker: ThreadPoolExecutor | None = None
+        self._critic_step_job: Future | None = None  # the last update's, on the worker
         self.device = torch.device(device)
         self.actor = make_actor(cfg, obs_dim, act_dim).to(self.device)
         self.critic = QuantileCritics(
@@ -75,10 +80,10 @@ class TQCAgent:
         self._target = list(self.critic_target.parameters())
 
     def start_worker(self, flush_denormal: bool = True) -> None:
-        """Run the critics' half of every update on a second thread (CPU, 2+ cores).
+        """Run the critics' part of every update on a second thread (CPU, 2+ cores).
 
-        Meant for one intra-op thread per half: ``torch.set_num_threads(1)``; batch-64 matrix
-        products split badly across cores, two independent halves split well. Denormal
+        Meant for one intra-op thread per part, ``torch.set_num_threads(1)``: batch-64 matrix
+        products split badly across cores, two independent parts split well. Denormal
         flushing is a per-thread CPU flag, so the worker sets its own.
         """
         if self._worker is None:
@@ -87,12 +92,23 @@ class TQCAgent:
             )
 
     def stop_worker(self) -> None:
+        self.sync()
         if self._worker is not None:
             self._worker.shutdown()
             self._worker = None
 
+    def sync(self) -> None:
+        """Wait for the critics' step of the last update, which the worker may still be running.
+
+        Everything here that reads the critics calls it first; code outside that reads
+        ``critic``/``critic_target`` directly between updates must too.
+        """
+        if self._critic_step_job is not None:
+            job, self._critic_step_job = self._critic_step_job, None
+            job.result()
+
     # ------------------------------------------------------------------ acting
-    @torch.no_grad()
+    @torch.inference_mode()
     def act(self, obs: np.ndarray, deterministic: bool = False) -> np.ndarray:
         """obs: (obs_dim,) or (B, obs_dim) -> action(s) in [-1, 1]."""
         x = torch.as_tensor(obs, dtype=torch.float32, device=self.device)
@@ -101,7 +117,7 @@ class TQCAgent:
         if deterministic:
             action = self.actor.deterministic(x)
         else:
-            action, _ = self.actor.sample(x, generator=self.noise)
+            action = self.actor.sample_action(x, generator=self.noise)
         action = action.cpu().numpy()
         return action[0] if single else action
 
@@ -109,20 +125,24 @@ class TQCAgent:
     def batch_to_tensors(self, batch: dict[str, np.ndarray]) -> dict[str, torch.Tensor]:
         return {k: torch.as_tensor(v, device=self.device) for k, v in batch.items()}
 
-    def update(self, batch: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+    def update(self, batch: dict[str, torch.Tensor]) -> Mapping[str, torch.Tensor]:
         """One TQC step on a batch; returns detached 0-dim metric tensors (no host sync here).
 
         As in the paper's algorithm (and the TQC authors' code), the three gradients
         grad J_Z(psi), grad J_pi(phi) and grad J(alpha) are all taken at the current
-        parameters; then every parameter moves. The critics' part (target, eq. 1, Adam,
-        Polyak) and the actor's part (eqs. 2-3, Adam) meet in two places only: the target
-        needs a' ~ pi(.|s') from the actor before the actor's step, and the actor loss reads
-        the critics before the critics' step. With a worker thread (:meth:`start_worker`) the
-        critics' part runs there and the actor's part on the calling thread (ATen releases
-        the GIL inside each op); two events order those reads before the writes, so the
-        result is the same to the bit as without the worker.
+        parameters; then every parameter moves. So the critics' part (a' ~ pi(.|s'), the
+        target, eq. 1, Adam, Polyak) and the actor's part (eqs. 2-3, Adam) meet in two places
+        only: a' reads the actor before the actor's step, and the actor loss reads the critics
+        before the critics' step. With a worker thread (:meth:`start_worker`) the critics'
+        part runs there and the actor's part on the calling thread (ATen releases the GIL
+        inside each op); two events order those reads before the writes. The call returns
+        once the actor has moved, while the critics' step may still run on the worker (it
+        overlaps acting and stepping the env); the next update, :meth:`sync` and reading the
+        returned metrics wait for it. Every operation sees the same values in the same order
+        as without the worker, so the results are equal to the bit.
         """
-        obs, next_obs = batch["obs"], batch["next_obs"]
+        self.sync()  # the actor loss reads the critics: their last step must be done
+        obs = batch["obs"]
         # (2, B, A): eps[0] draws a ~ pi(.|s) for eqs. 2-3, eps[1] a' ~ pi(.|s') for the target
         eps = torch.randn(
             (2, obs.shape[0], self.act_dim),
@@ -132,42 +152,57 @@ class TQCAgent:
         )
         alpha = self.log_alpha.detach().exp()
         if self._worker is None:
-            next_sample = _Handoff()
-            next_sample.put(self._next_action(next_obs, eps[1]))
-            critic_metrics = self._critic_gradients(batch, alpha, next_sample)
+            critic_metrics = self._critic_gradients(batch, eps[1], alpha)
             actor_metrics = self._actor_gradients(obs, eps[0], alpha)
             self._critic_step()
             self._actor_step()
-        else:
-            next_sample, actor_loss_done = _Handoff(), threading.Event()
-            job = self._worker.submit(self._critic_part, batch, alpha, next_sample, actor_loss_done)
-            try:
-                next_sample.put(self._next_action(next_obs, eps[1]))
-                actor_metrics = self._actor_gradients(obs, eps[0], alpha)
-            finally:
-                next_sample.put(None)  # never leave the worker waiting, even after an error
-                actor_loss_done.set()
-            self._actor_step()
-            critic_metrics = job.result()
+            self.updates += 1
+            return {**critic_metrics, **actor_metrics, "alpha": alpha}
+        actor_read, critic_read = threading.Event(), threading.Event()
+        job = self._worker.submit(self._critic_part, batch, eps[1], alpha, actor_read, critic_read)
+        try:
+            actor_metrics = self._actor_gradients(obs, eps[0], alpha)
+        finally:
+            critic_read.set()  # set even after an error: never leave the worker waiting
+            actor_read.wait()  # the worker sets it even when it fails
+        self._critic_step_job = job
+        self._actor_step()
         self.updates += 1
-        return {**critic_metrics, **actor_metrics, "alpha": alpha}
+        return _MetricsWhenDone(job, {**actor_metrics, "alpha": alpha})
 
-    @torch.no_grad()
-    def _next_action(
-        self, next_obs: torch.Tensor, eps: torch.Tensor
-    ) -> tuple[torch.Tensor, torch.Tensor]:
-        """a' ~ pi(.|s') and log pi(a'|s') for the target, (B, A) and (B,)."""
-        return self.actor.sample(next_obs, eps=eps)
+    def _critic_part(
+        self,
+        batch: dict[str, torch.Tensor],
+        eps: torch.Tensor,
+        alpha: torch.Tensor,
+        actor_read: threading.Event,
+        critic_read: threading.Event,
+    ) -> dict[str, torch.Tensor]:
+        """The worker's share of :meth:`update`: critic gradients, then (after the actor loss
+        has read the critics) their step."""
+        try:
+            metrics = self._critic_gradients(batch, eps, alpha, actor_read)
+        finally:
+            actor_read.set()
+        critic_read.wait()
+        self._critic_step()
+        return metrics
 
     def _critic_gradients(
-        self, batch: dict[str, torch.Tensor], alpha: torch.Tensor, next_sample: _Handoff
+        self,
+        batch: dict[str, torch.Tensor],
+        eps: torch.Tensor,
+        alpha: torch.Tensor,
+        actor_read: threading.Event | None = None,
     ) -> dict[str, torch.Tensor]:
         """grad J_Z(psi) of eq. (1) against the truncated target, into the critics' .grad."""
         cfg = self.cfg
-        atoms = self.critic(batch["obs"], batch["action"])  # (B, N, M)
-        next_action, next_log_prob = next_sample.get()  # (B, A), (B,)
         with torch.no_grad():
-            next_atoms = self.critic_target(batch["next_obs"], next_action)  # (B, N, M)
+            next_obs = batch["next_obs"]
+            next_action, next_log_prob = self.actor.sample(next_obs, eps=eps)  # (B, A), (B,)
+            if actor_read is not None:
+                actor_read.set()  # done with the actor: its step may go ahead
+            next_atoms = self.critic_target(next_obs, next_action)  # (B, N, M)
             target = truncated_target(
                 next_atoms,
                 batch["reward"],
@@ -177,6 +212,7 @@ class TQCAgent:
                 cfg.gamma,
                 cfg.drop_per_critic,
             )  # (B, K)
+        atoms = self.critic(batch["obs"], batch["action"])  # (B, N, M)
         critic_loss = quantile_huber_loss(atoms, target)
         self.critic_opt.zero_grad(set_to_none=True)
         critic_loss.backward()
@@ -187,19 +223,6 @@ class TQCAgent:
         self.critic_opt.step()
         with torch.no_grad():
             torch._foreach_lerp_(self._target, self._online, self.cfg.tau)
-
-    def _critic_part(
-        self,
-        batch: dict[str, torch.Tensor],
-        alpha: torch.Tensor,
-        next_sample: _Handoff,
-        actor_loss_done: threading.Event,
-    ) -> dict[str, torch.Tensor]:
-        """The worker thread's share of :meth:`update`."""
-        metrics = self._critic_gradients(batch, alpha, next_sample)
-        actor_loss_done.wait()  # the actor loss has read the critics' weights (backward too)
-        self._critic_step()
-        return metrics
 
     def _actor_gradients(
         self, obs: torch.Tensor, eps: torch.Tensor, alpha: torch.Tensor
@@ -226,6 +249,7 @@ class TQCAgent:
 
     # ------------------------------------------------------------- persistence
     def state_dict(self) -> dict:
+        self.sync()
         return {
             "actor": self.actor.state_dict(),
             "critic": self.critic.state_dict(),
@@ -239,6 +263,7 @@ class TQCAgent:
         }
 
     def load_state_dict(self, state: dict) -> None:
+        self.sync()
         self.actor.load_state_dict(state["actor"])
         self.critic.load_state_dict(state["critic"])
         self.critic_target.load_state_dict(state["critic_target"])

@@ -149,6 +149,14 @@ class SquashedGaussianActor(nn.Module):
         u = mean + log_std.exp() * eps
         return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std)
 
+    def sample_action(
+        self, obs: torch.Tensor, generator: torch.Generator | None = None
+    ) -> torch.Tensor:
+        """The action of :meth:`sample` alone, (B, A): exploration needs no log pi."""
+        mean, log_std = self.distribution_params(obs)
+        eps = torch.randn(mean.shape, generator=generator, device=mean.device, dtype=mean.dtype)
+        return torch.tanh(mean + log_std.exp() * eps)
+
 
 def squashed_gaussian_log_prob(
     u: torch.Tensor, eps: torch.Tensor, log_std: torch.Tensor

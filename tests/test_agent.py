@@ -115,8 +115,10 @@ def test_all_gradients_are_taken_at_the_parameters_before_the_update(worker):
 def test_an_error_on_the_worker_thread_reaches_the_caller():
     agent = make_agent(worker=True)
     try:
-        with pytest.raises(RuntimeError):
+        with pytest.raises(RuntimeError):  # by the next call that waits for the worker
             agent.update(make_batch(0, act_dim=ACT + 1))  # the critics' part fails on a shape
-        agent.update(make_batch(1))  # the worker is still usable afterwards
+            agent.sync()
+        metrics = agent.update(make_batch(1))  # the worker is still usable afterwards
+        assert torch.isfinite(metrics["critic_loss"])
     finally:
         agent.stop_worker()

@@ -153,3 +153,14 @@ def test_sort_rows_matches_torch_sort(dtype):
     assert sort_rows(x).dtype == dtype
     g = x.clone().requires_grad_(True)  # inside autograd: torch.sort's path
     assert torch.equal(sort_rows(g), torch.sort(x, dim=1).values)
+
+
+@pytest.mark.parametrize("K", [1, 2, 7, 8, 115, 128])
+def test_count_less_matches_searchsorted_left_and_right(K):
+    from bipedal_cli.losses import count_less
+
+    gen = torch.Generator().manual_seed(K)
+    y = torch.sort(torch.randint(-8, 8, (16, K), generator=gen).to(f64) / 2, dim=1).values
+    q = torch.randint(-20, 20, (16, 40), generator=gen).to(f64) / 2  # ties, below and above all
+    assert torch.equal(count_less(y, q), torch.searchsorted(y, q, side="left"))
+    assert torch.equal(count_less(y, q, or_equal=True), torch.searchsorted(y, q, side="right"))
