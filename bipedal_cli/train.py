@@ -16,6 +16,7 @@ import signal
 import threading
 import time
 from collections import deque
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
@@ -129,7 +130,7 @@ class Trainer:
         self.last_eval: dict | None = None
         self.full_eval: dict | None = None
         self.last_metrics: dict[str, float] = {}
-        self._update_metrics: dict[str, torch.Tensor] | None = None  # last update's, unsynced
+        self._update_metrics: Mapping[str, torch.Tensor] | None = None  # last update's, unsynced
         self.curriculum: dict[str, Any] | None = None  # set by curriculum.py
         self._stop_requested = False
 
