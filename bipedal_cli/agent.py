@@ -92,10 +92,12 @@ class TQCAgent:
             )
 
     def stop_worker(self) -> None:
-        self.sync()
-        if self._worker is not None:
-            self._worker.shutdown()
-            self._worker = None
+        try:
+            self.sync()
+        finally:
+            if self._worker is not None:
+                self._worker.shutdown()
+                self._worker = None
 
     def sync(self) -> None:
         """Wait for the critics' step of the last update, which the worker may still be running.
