@@ -143,19 +143,23 @@ class SquashedGaussianActor(nn.Module):
         eps ~ N(0, I), (B, A), is drawn from ``generator`` unless given (the agent draws the
         noise of a whole update up front, so that its two halves can run in two threads).
         """
-        mean, log_std = self.distribution_params(obs)
-        if eps is None:
-            eps = torch.randn(mean.shape, generator=generator, device=mean.device, dtype=mean.dtype)
-        u = mean + log_std.exp() * eps
+        u, eps, log_std = self._pre_tanh(obs, generator, eps)
         return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std)
 
     def sample_action(
         self, obs: torch.Tensor, generator: torch.Generator | None = None
     ) -> torch.Tensor:
         """The action of :meth:`sample` alone, (B, A): exploration needs no log pi."""
+        return torch.tanh(self._pre_tanh(obs, generator, None)[0])
+
+    def _pre_tanh(
+        self, obs: torch.Tensor, generator: torch.Generator | None, eps: torch.Tensor | None
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """u = mu + sigma * eps, with eps and log sigma: (B, A) each."""
         mean, log_std = self.distribution_params(obs)
-        eps = torch.randn(mean.shape, generator=generator, device=mean.device, dtype=mean.dtype)
-        return torch.tanh(mean + log_std.exp() * eps)
+        if eps is None:
+            eps = torch.randn(mean.shape, generator=generator, device=mean.device, dtype=mean.dtype)
+        return mean + log_std.exp() * eps, eps, log_std
 
 
 def squashed_gaussian_log_prob(
