@@ -5,7 +5,7 @@
 1. quantile Huber loss + backward: pairwise (B x N x M x K tensor) against the sorted closed form;
 2. Adam step over the critics' parameters: foreach against fused;
 3. sorting the pooled target atoms (64 x 125): torch.sort against NumPy's sort (``sort_rows``),
-   and the loss's binary searches: torch.searchsorted against ``count_less``;
+   and the loss's binary searches: torch.searchsorted against ``count_below``;
 4. where one update's time goes: every ATen op timed by category (matrix products, optimizer,
    sort/search, the rest) against the update's wall time; the difference is Python and autograd;
 5. the matrix products' floor: an update's FLOPs over one core's large-product GFLOP/s;
@@ -64,7 +64,7 @@ def sort_timings() -> None:
 
 def search_timings() -> None:
     """The loss's three searches of 64 x 125 atoms among 115 sorted targets, in float64."""
-    from bipedal_cli.losses import count_less
+    from bipedal_cli.losses import count_below
 
     y = torch.sort(torch.randn(64, 115, dtype=torch.float64), dim=1).values
     theta = torch.randn(64, 125, dtype=torch.float64)
@@ -74,12 +74,11 @@ def search_timings() -> None:
         torch.searchsorted(y, theta, side="left")
         torch.searchsorted(y, theta + 1.0, side="right")
 
-    def with_count_less():
-        count_less(y, torch.cat([theta - 1.0, theta], 1))
-        count_less(y, theta + 1.0, or_equal=True)
+    def with_count_below():
+        count_below(y, torch.cat([theta - 1.0, theta], 1), theta + 1.0)
 
-    a, b = per_call_ms(with_searchsorted, 300), per_call_ms(with_count_less, 300)
-    print(f"loss searches: torch.searchsorted {a:.3f} ms, count_less (branch-free) {b:.3f} ms")
+    a, b = per_call_ms(with_searchsorted, 300), per_call_ms(with_count_below, 300)
+    print(f"loss searches: torch.searchsorted {a:.3f} ms, count_below (branch-free) {b:.3f} ms")
 
 
 def _category(name: str) -> str:

@@ -14,6 +14,8 @@ of y and y^2 give it in closed form. :func:`quantile_huber_loss_pairwise` is the
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import torch
 
@@ -22,6 +24,16 @@ def quantile_fractions(n_quantiles: int, device=None, dtype=torch.float32) -> to
     """tau_m = (2m - 1) / (2M), m = 1..M: the midpoints of M equal quantile bins, shape (M,)."""
     m = torch.arange(1, n_quantiles + 1, device=device, dtype=dtype)
     return (2 * m - 1) / (2 * n_quantiles)
+
+
+@functools.lru_cache(maxsize=8)
+def _fractions_per_atom(
+    n_critics: int, n_quantiles: int, device: torch.device
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """tau and 1 - tau for the N*M atoms of (B, N, M) flattened, float64, made once per shape."""
+    with torch.inference_mode(False), torch.no_grad():
+        tau = quantile_fractions(n_quantiles, device, torch.float64).repeat(n_critics)
+        return tau, 1 - tau
 
 
 def truncated_target(
@@ -63,25 +75,39 @@ def sort_rows(x: torch.Tensor) -> torch.Tensor:
     return torch.sort(x, dim=1).values
 
 
-def count_less(y: torch.Tensor, q: torch.Tensor, or_equal: bool = False) -> torch.Tensor:
-    """#{j : y[b, j] < q[b, i]} (``or_equal``: <=) for ascending rows y (B, K), queries q (B, Q).
+def count_below(
+    y: torch.Tensor, strict: torch.Tensor, weak: torch.Tensor
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """#{j : y[b, j] < strict[b, i]} and #{j : y[b, j] <= weak[b, i]} for ascending rows y (B, K).
 
-    The same integers as ``torch.searchsorted(y, q, side="left")`` (``"right"``), about 2x
-    faster on CPU at the loss's sizes: a branch-free binary search over y padded with +inf to a
-    power of two, every query advancing together (a search with unpredictable branches stalls
-    on each comparison).
+    strict: (B, S), weak: (B, W) -> (B, S), (B, W) int64: the integers of
+    ``torch.searchsorted(y, strict, side="left")`` and ``(y, weak, side="right")``, in one
+    branch-free binary search that moves every query together (a search with unpredictable
+    branches stalls on each comparison; one search instead of two halves the small ops).
+    ``y <= w`` is ``not (-y < -w)``, exact in floating point, so the weak queries search the
+    reversed, negated rows with the same strict comparison, in the second half of one row::
+
+        table[b] = [y_b, +inf ..., -reversed(y_b), +inf ...]      each half 2**depth > K long
+
+    A query's position starts at its half's first index and gains ``step`` for each probe
+    ``table[position + step - 1]`` below it, step = 2**(depth-1), ..., 1.
     """
     B, K = y.shape
-    depth = K.bit_length()  # 2**depth > K
-    y_pad = torch.cat([y, y.new_full((B, 2**depth - K), float("inf"))], 1)  # (B, 2**depth)
-    count = torch.zeros(q.shape, dtype=torch.long, device=q.device)  # (B, Q)
-    step = 2 ** (depth - 1)
-    below = torch.le if or_equal else torch.lt
-    while step >= 1:  # invariant: y[count - 1] below q; y[count + 2 * step - 1] not (or +inf)
-        probe = y_pad.gather(1, count + (step - 1))  # (B, Q)
-        count += below(probe, q).long() * step
+    half = 2 ** K.bit_length()  # > K: the last probe of a half is +inf
+    inf_pad = y.new_full((B, half - K), float("inf"))
+    table = torch.cat([y, inf_pad, -y.flip(1), inf_pad], 1)  # (B, 2 * half)
+    queries = torch.cat([strict, -weak], 1)  # (B, S + W)
+    n_strict = strict.shape[1]
+    position = torch.zeros(queries.shape, dtype=torch.long, device=y.device)  # (B, S + W)
+    position[:, n_strict:] = half
+    step = half // 2
+    while step >= 1:  # invariant: table[position - 1] < query <= table[position + 2 * step - 1]
+        probe = table[:, step - 1 :].gather(1, position)  # table[position + step - 1]: (B, S + W)
+        position.add_(probe < queries, alpha=step)
         step //= 2
-    return count
+    below_strict = position[:, :n_strict]  # (B, S)
+    above_weak = position[:, n_strict:] - half  # #{y > weak}: (B, W)
+    return below_strict, K - above_weak
 
 
 def quantile_huber_loss_pairwise(atoms: torch.Tensor, target: torch.Tensor) -> torch.Tensor:
@@ -111,39 +137,34 @@ class _SortedQuantileHuber(torch.autograd.Function):
         center = y.mean(dim=1, keepdim=True)  # (B, 1): shifting y and theta keeps u unchanged
         y = y - center
         theta = atoms.detach().double().reshape(B, N * M) - center  # (B, N*M)
-        tau = quantile_fractions(M, atoms.device, torch.float64).repeat(N)  # (N*M,)
+        tau, one_minus_tau = _fractions_per_atom(N, M, atoms.device)  # (N*M,) each
 
-        zero = y.new_zeros(B, 1)
-        s1 = torch.cat([zero, y.cumsum(1)], 1)  # (B, K+1): s1[j] = sum_{i<j} y_i
-        s2 = torch.cat([zero, (y * y).cumsum(1)], 1)  # (B, K+1)
-        i0, i1 = count_less(y, torch.cat([theta - 1.0, theta], 1)).chunk(2, 1)  # #{u<-1}, #{u<0}
-        i2 = count_less(y, theta + 1.0, or_equal=True)  # #{u <= 1}: (B, N*M) each
-
-        def range_sum(prefix, lo, hi):  # sum over y_i, i in [lo, hi): (B, N*M)
-            return prefix.gather(1, hi) - prefix.gather(1, lo)
-
-        c0, c1, c2 = i0.double(), (i1 - i0).double(), (i2 - i1).double()
+        powers = torch.stack([y, y * y], 1)  # (B, 2, K): y_i and y_i^2
+        prefix = torch.cat([powers.new_zeros(B, 2, 1), powers.cumsum(2)], 2)  # (B, 2, K+1)
+        # #{u < -1}, #{u < 0} and #{u <= 1} for every atom: i0 <= i1 <= i2, (B, N*M) each
+        strict, i2 = count_below(y, torch.cat([theta - 1.0, theta], 1), theta + 1.0)
+        i0, i1 = strict.chunk(2, 1)
+        bounds = torch.cat([strict, i2], 1).unsqueeze(1).expand(B, 2, 3 * N * M)
+        # prefix[b, p, j] = sum_{i<j} y_i^(p+1); at the three bounds: (B, N*M) each
+        s1, s2 = prefix.gather(2, bounds).unbind(1)  # (B, 3*N*M) each
+        (s1_0, s1_1, s1_2), (s2_0, s2_1, s2_2) = s1.chunk(3, 1), s2.chunk(3, 1)
+        sum_lo, sum_neg, sum_pos = s1_0, s1_1 - s1_0, s1_2 - s1_1  # sums of y over the ranges
+        sum_hi = prefix[:, 0, K:] - s1_2
+        sq_neg, sq_pos = s2_1 - s2_0, s2_2 - s2_1  # sums of y^2
+        c0, c1, c2 = i0.double(), (i1 - i0).double(), (i2 - i1).double()  # range sizes
         c3 = K - i2.double()
-        last = torch.full_like(i2, K)
-        first = torch.zeros_like(i0)
-        sum_lo, sum_neg, sum_pos = (
-            range_sum(s1, first, i0),
-            range_sum(s1, i0, i1),
-            range_sum(s1, i1, i2),
-        )
-        sum_hi = range_sum(s1, i2, last)
-        sq_neg, sq_pos = range_sum(s2, i0, i1), range_sum(s2, i1, i2)
+        theta_sq, two_theta = theta**2, 2 * theta
 
         # sum_i |tau - 1(u<0)| L_H(u), range by range (u = y - theta):
         #   u < -1: (1 - tau)(theta - y - 1/2)       -1 <= u < 0: (1 - tau)(y - theta)^2 / 2
         #   0 <= u <= 1: tau (y - theta)^2 / 2       u > 1: tau (y - theta - 1/2)
-        value = (1 - tau) * (
-            c0 * (theta - 0.5) - sum_lo + 0.5 * (sq_neg - 2 * theta * sum_neg + c1 * theta**2)
+        value = one_minus_tau * (
+            c0 * (theta - 0.5) - sum_lo + 0.5 * (sq_neg - two_theta * sum_neg + c1 * theta_sq)
         ) + tau * (
-            0.5 * (sq_pos - 2 * theta * sum_pos + c2 * theta**2) + sum_hi - c3 * (theta + 0.5)
+            0.5 * (sq_pos - two_theta * sum_pos + c2 * theta_sq) + sum_hi - c3 * (theta + 0.5)
         )
         # d/dtheta: -sum_i |tau - 1(u<0)| clip(u, -1, 1)
-        slope = (1 - tau) * (-c0 + sum_neg - c1 * theta) + tau * (sum_pos - c2 * theta + c3)
+        slope = one_minus_tau * (-c0 + sum_neg - c1 * theta) + tau * (sum_pos - c2 * theta + c3)
         count = B * N * M * K
         ctx.save_for_backward(slope)
         ctx.shape, ctx.count, ctx.dtype = atoms.shape, count, atoms.dtype

@@ -156,11 +156,13 @@ def test_sort_rows_matches_torch_sort(dtype):
 
 
 @pytest.mark.parametrize("K", [1, 2, 7, 8, 115, 128])
-def test_count_less_matches_searchsorted_left_and_right(K):
-    from bipedal_cli.losses import count_less
+def test_count_below_matches_searchsorted_left_and_right(K):
+    from bipedal_cli.losses import count_below
 
     gen = torch.Generator().manual_seed(K)
     y = torch.sort(torch.randint(-8, 8, (16, K), generator=gen).to(f64) / 2, dim=1).values
     q = torch.randint(-20, 20, (16, 40), generator=gen).to(f64) / 2  # ties, below and above all
-    assert torch.equal(count_less(y, q), torch.searchsorted(y, q, side="left"))
-    assert torch.equal(count_less(y, q, or_equal=True), torch.searchsorted(y, q, side="right"))
+    w = torch.cat([q[:, :30], -q[:, :1] * 0.0], 1)  # another width, and -0.0 against +0.0
+    strict, weak = count_below(y, q, w)
+    assert torch.equal(strict, torch.searchsorted(y, q, side="left"))
+    assert torch.equal(weak, torch.searchsorted(y, w, side="right"))
