@@ -87,10 +87,10 @@ def count_below(
     ``y <= w`` is ``not (-y < -w)``, exact in floating point, so the weak queries search the
     reversed, negated rows with the same strict comparison, in the second half of one row::
 
-        table[b] = [y_b, +inf ..., -reversed(y_b), +inf ...]      each half 2**depth > K long
+        table[b] = [y_b, +inf ..., -reversed(y_b), +inf ...]      each half a power of 2 > K long
 
     A query's position starts at its half's first index and gains ``step`` for each probe
-    ``table[position + step - 1]`` below it, step = 2**(depth-1), ..., 1.
+    ``table[position + step - 1]`` below it, step = half/2, ..., 1.
     """
     B, K = y.shape
     half = 2 ** K.bit_length()  # > K: the last probe of a half is +inf
@@ -101,7 +101,7 @@ def count_below(
     position = torch.zeros(queries.shape, dtype=torch.long, device=y.device)  # (B, S + W)
     position[:, n_strict:] = half
     step = half // 2
-    while step >= 1:  # invariant: table[position - 1] < query <= table[position + 2 * step - 1]
+    while step >= 1:  # invariant: the answer is in [position, position + 2 * step)
         probe = table[:, step - 1 :].gather(1, position)  # table[position + step - 1]: (B, S + W)
         position.add_(probe < queries, alpha=step)
         step //= 2
