@@ -90,6 +90,7 @@ def measure_ours(threads: int, steps: int, device: str, eval_episodes: int, spli
     start = time.perf_counter()
     for b in batches:
         trainer.agent.update(b)
+    trainer.agent.sync()  # the last critics' step may still run on the worker thread
     if device != "cpu":
         torch.cuda.synchronize()
     update_sps = len(batches) / (time.perf_counter() - start)
