@@ -11,7 +11,6 @@ import time
 from pathlib import Path
 from typing import Annotated
 
-import click
 import typer
 from rich.console import Console
 
@@ -28,20 +27,10 @@ app = typer.Typer(
 console = Console()
 
 
-def _exception_types(name: str) -> tuple[type[BaseException], ...]:
-    """``name`` from click and from the click copy newer typer releases vendor."""
-    found = [getattr(click.exceptions, name)]
-    try:
-        from typer._click import exceptions as vendored
-    except ImportError:
-        vendored = None
-    if vendored is not None and hasattr(vendored, name):
-        found.append(getattr(vendored, name))
-    return tuple(found)
-
-
-_CLICK_ERRORS = _exception_types("ClickException")
-_ABORTS = _exception_types("Abort") + (typer.Abort,)
+# typer >= 0.29 carries its own click: its usage errors derive from the public
+# typer.TyperException, and typer.Abort is what it raises on an abort.
+_CLICK_ERRORS = (typer.TyperException,)
+_ABORTS = (typer.Abort,)
 
 EnvOpt = Annotated[
     str | None, typer.Option("--env", help="walker | hardcore (or a full Gymnasium id).")

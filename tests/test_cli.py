@@ -196,3 +196,19 @@ def test_ctrl_c_saves_a_checkpoint_and_exits_cleanly(tmp_path, tiny_yaml):
     state = load_checkpoint(run / "state.pt")
     assert 0 < state["counters"]["step"] < 1_000_000
     assert load_checkpoint(run / "policy.pt")["meta"]["steps"] == state["counters"]["step"]
+
+
+def test_installed_console_script_lists_every_command():
+    """`bipedal --help` from the installed entry point, in a fresh process: what a new user runs
+    first. It fails when a module the CLI imports is missing from the environment."""
+    from pathlib import Path
+
+    script = Path(sys.executable).parent / "bipedal"
+    assert script.exists(), f"no console script beside {sys.executable}: install with pip first"
+    proc = subprocess.run(
+        [str(script), "--help"], capture_output=True, text=True, timeout=120,
+        env={"COLUMNS": "200", "PATH": str(script.parent)},
+    )
+    assert proc.returncode == 0, proc.stderr
+    for command in ("train", "resume", "eval", "record", "curriculum", "plot", "export", "info"):
+        assert f" {command} " in proc.stdout, f"`{command}` missing from bipedal --help"
