@@ -213,6 +213,7 @@ class TQCAgent:
                 alpha,
                 cfg.gamma,
                 cfg.drop_per_critic,
+                batch.get("discount") if cfg.n_step > 1 else None,
             )  # (B, K)
         atoms = self.critic(batch["obs"], batch["action"])  # (B, N, M)
         critic_loss = quantile_huber_loss(atoms, target)

@@ -11,11 +11,16 @@ class ReplayBuffer:
     """Fixed-capacity FIFO of transitions (s, a, r, s', terminated).
 
     ``terminated`` is 1.0 only when the episode really ended (fall or finish); time-limit
-    truncations are stored as 0.0 so that their targets bootstrap.
+    truncations are stored as 0.0 so that their targets bootstrap. ``with_discount`` adds a
+    ``discount`` field, gamma^m (1 - terminated), for n-step transitions (:mod:`.nstep`).
     """
 
-    def __init__(self, capacity: int, obs_dim: int, act_dim: int) -> None:
+    def __init__(
+        self, capacity: int, obs_dim: int, act_dim: int, with_discount: bool = False
+    ) -> None:
         self.capacity, self.obs_dim, self.act_dim = capacity, obs_dim, act_dim
+        self.fields = FIELDS + (("discount",) if with_discount else ())
+        self.discount = np.zeros((capacity,), np.float32) if with_discount else None
         self.obs = np.zeros((capacity, obs_dim), np.float32)
         self.action = np.zeros((capacity, act_dim), np.float32)
         self.reward = np.zeros((capacity,), np.float32)
@@ -27,8 +32,12 @@ class ReplayBuffer:
     def __len__(self) -> int:
         return self.size
 
-    def add(self, obs, action, reward: float, next_obs, terminated: bool) -> None:
+    def add(
+        self, obs, action, reward: float, next_obs, terminated: bool, discount: float = 0.0
+    ) -> None:
         i = self.pos
+        if self.discount is not None:
+            self.discount[i] = discount
         self.obs[i] = obs
         self.action[i] = action
         self.reward[i] = reward
@@ -42,7 +51,7 @@ class ReplayBuffer:
         if self.size == 0:
             raise ValueError("cannot sample from an empty replay buffer")
         idx = rng.integers(0, self.size, size=batch_size)
-        return {name: getattr(self, name)[idx] for name in FIELDS}
+        return {name: getattr(self, name)[idx] for name in self.fields}
 
     def state_dict(self) -> dict:
         """The filled slots in storage order plus the write position.
@@ -50,7 +59,7 @@ class ReplayBuffer:
         Storage order (not chronological order) is kept so that the same sampled indices pick
         the same transitions after a resume.
         """
-        data = {name: getattr(self, name)[: self.size].copy() for name in FIELDS}
+        data = {name: getattr(self, name)[: self.size].copy() for name in self.fields}
         return {"capacity": self.capacity, "size": self.size, "pos": self.pos, **data}
 
     def load_state_dict(self, state: dict) -> None:
@@ -59,6 +68,6 @@ class ReplayBuffer:
             raise ValueError(
                 f"buffer state (size {size}, pos {pos}) does not fit capacity {self.capacity}"
             )
-        for name in FIELDS:
+        for name in self.fields:
             getattr(self, name)[:size] = state[name]
         self.size, self.pos = size, pos

@@ -123,7 +123,7 @@ def resume(
     """Continue a run exactly where its last checkpoint left it."""
     from .display import TrainingDisplay
     from .train import resolve_device
-    from .train import resume as resume_run
+    from .resume import resume as resume_run
 
     if device:
         resolve_device(device)
@@ -194,14 +194,12 @@ def eval_(
 def _load_policy(ckpt: Path, env: str | None):
     """(checkpoint data, actor, config, env id) with the dims checked against the env."""
     from .checkpoint import actor_from_checkpoint, check_dims, load_checkpoint
-    from .envs import env_dims, make_env
+    from .envs import policy_dims
 
     data = load_checkpoint(ckpt)
     actor, cfg = actor_from_checkpoint(data)
     env_id = canonical_env_id(env) if env else data["env"]
-    probe = make_env(env_id)
-    check_dims(data, *env_dims(probe), env_id)
-    probe.close()
+    check_dims(data, *policy_dims(env_id, cfg.agent), env_id)
     return data, actor, cfg, env_id
 
 
@@ -256,7 +254,7 @@ def record(
         TimeElapsedColumn(),
         console=console,
     ) as progress:
-        task = progress.add_task("render", total=episodes * (max_steps + 1))
+        task = progress.add_task("render", total=episodes * (max_steps // frame_step + 1))
         recorded, frames, rate = record_video(
             actor_policy(actor),
             env_id,
@@ -266,6 +264,7 @@ def record(
             frame_step,
             scale,
             on_frame=lambda: progress.advance(task),
+            agent_cfg=cfg.agent,
         )
         progress.update(task, total=progress.tasks[0].completed)
     for ep in recorded:
@@ -371,14 +370,17 @@ def export(
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
     """Export the deterministic policy for use with torch alone: torch.export.load(out).module()."""
-    from .export import EXPORT_SUFFIXES, export_policy
+    from .export import EXPORT_SUFFIXES, export_policy, input_shape
 
     check_output_path(out, "--out", EXPORT_SUFFIXES, force)
-    data, actor, _, _ = _load_policy(ckpt, None)
-    export_policy(actor, out)
+    data, actor, cfg, _ = _load_policy(ckpt, None)
+    a = cfg.agent
+    export_policy(actor, out, a.history, a.action_repeat)
+    shape = ", ".join(str(d) for d in ("B", *input_shape(data["obs_dim"], a.history)))
+    held = f"; hold each action for {a.action_repeat} env steps" if a.action_repeat > 1 else ""
     console.print(
-        f"wrote {out}: torch.export program, obs (B, {data['obs_dim']}) -> actions "
-        f"(B, {data['act_dim']}); load with torch.export.load({str(out)!r}).module()"
+        f"wrote {out}: torch.export program, obs ({shape}) -> actions (B, {data['act_dim']})"
+        f"{held}; load with torch.export.load({str(out)!r}).module()"
     )
 
 
@@ -410,6 +412,12 @@ def info(ckpt: Annotated[Path, typer.Argument(metavar="CKPT")]) -> None:
     table.add_row("kind", f"{kind} ({data['format']} v{data['version']})")
     table.add_row("env", data["env"])
     table.add_row("obs / action size", f"{data['obs_dim']} / {data['act_dim']}")
+    agent = data["config"].get("agent", {})
+    table.add_row(
+        "policy",
+        f"last {agent.get('history', 1)} observation(s); each action held for "
+        f"{agent.get('action_repeat', 1)} env step(s)",
+    )
     for key, value in meta.items():
         if isinstance(value, dict):
             value = ", ".join(

@@ -70,6 +70,16 @@ class AgentConfig:
     """Lower clamp of the actor's log standard deviation."""
     log_std_max: float = 2.0
     """Upper clamp of the actor's log standard deviation."""
+    action_repeat: int = 1
+    """k: the policy holds each action for k env steps (their rewards summed). Part of the
+    policy: evaluation, recording and export apply it too."""
+    history: int = 1
+    """H: the networks see the last H observations (oldest first, H * 24 inputs). Part of the
+    policy, like ``action_repeat``."""
+    n_step: int = 1
+    """n: targets sum n rewards, y = sum_{j<n} gamma^j r_{t+j} + gamma^n (1 - d) (z - alpha
+    log pi); an episode's end inside the n steps cuts the sum (termination also the
+    bootstrap)."""
 
 
 @dataclass
@@ -106,6 +116,11 @@ class TrainConfig:
     range within a few thousand steps and then slow every update down by up to 2x."""
     eval_seed: int = 1_000_000
     """First env seed of evaluation episodes (kept apart from training seeds)."""
+    fall_penalty: float | None = None
+    """Training only: the reward the learner sees when the walker falls, instead of the env's
+    -100 (null: unchanged). Evaluations always score the env's own reward."""
+    reward_scale: float = 1.0
+    """Training only: the learner's rewards (fall penalty included) are multiplied by this."""
 
 
 REPLAY_CHOICES = ("keep", "clear")
@@ -295,6 +310,10 @@ def validate(cfg: Config, source: str) -> None:
         (a.actor_hidden >= 1 and a.critic_hidden >= 1, "agent.*_hidden", "positive widths"),
         (a.n_layers >= 1, "agent.n_layers", "a positive integer"),
         (a.init_alpha > 0, "agent.init_alpha", "a positive number"),
+        (a.action_repeat >= 1, "agent.action_repeat", "a positive integer"),
+        (a.history >= 1, "agent.history", "a positive integer"),
+        (a.n_step >= 1, "agent.n_step", "a positive integer"),
+        (t.reward_scale > 0, "train.reward_scale", "a positive number"),
         (t.total_steps >= 0, "train.total_steps", "a non-negative integer"),
         (t.warmup_steps >= 0, "train.warmup_steps", "a non-negative integer"),
         (t.buffer_size >= 1, "train.buffer_size", "a positive integer"),

@@ -14,7 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from .config import ENV_ALIASES, Config
-from .train import Reporter, Trainer, TrainResult, default_run_dir, prepare_new_run_dir
+from .rundir import default_run_dir, prepare_new_run_dir
+from .train import Reporter, Trainer, TrainResult
 
 STAGES = (ENV_ALIASES["walker"], ENV_ALIASES["hardcore"])
 

@@ -17,7 +17,7 @@ import numpy as np
 import torch
 
 from .config import AgentConfig
-from .envs import is_fall, make_env
+from .envs import make_policy_env
 
 
 @dataclass
@@ -29,15 +29,21 @@ class EpisodeResult:
 
 
 def run_episodes(
-    policy: Callable[[np.ndarray], np.ndarray], env_id: str, seeds: list[int]
+    policy: Callable[[np.ndarray], np.ndarray],
+    env_id: str,
+    seeds: list[int],
+    agent_cfg: AgentConfig | None = None,
 ) -> list[EpisodeResult]:
     """Run one episode per seed in lockstep; ``policy`` maps (B, obs_dim) to (B, act_dim).
 
-    Each episode gets a new env: a reused Box2D world carries history across resets, and the
-    result of a seed should not depend on which episodes ran before it.
+    The env is the policy's (``agent_cfg``'s action repeat and observation history; none when
+    None) with the env's own reward and time limit. Each episode gets a new env: a reused Box2D
+    world carries history across resets, and the result of a seed should not depend on which
+    episodes ran before it. Lengths are in env steps.
     """
-    envs = [make_env(env_id) for _ in seeds]
-    obs = np.stack([env.reset(seed=int(s))[0] for env, s in zip(envs, seeds, strict=False)])
+    agent_cfg = agent_cfg or AgentConfig()
+    envs = [make_policy_env(env_id, agent_cfg) for _ in seeds]
+    obs = np.stack([env.reset(seed=int(s))[0] for env, s in zip(envs, seeds, strict=True)])
     returns = np.zeros(len(seeds))
     lengths = np.zeros(len(seeds), dtype=int)
     fell = np.zeros(len(seeds), dtype=bool)
@@ -46,18 +52,18 @@ def run_episodes(
         idx = np.flatnonzero(active)
         actions = policy(obs[idx].astype(np.float32))
         for j, i in enumerate(idx):
-            o, r, term, trunc, _ = envs[i].step(actions[j])
+            o, r, term, trunc, info = envs[i].step(actions[j])
             obs[i] = o
             returns[i] += r
-            lengths[i] += 1
+            lengths[i] += info["env_steps"]
             if term or trunc:
                 active[i] = False
-                fell[i] = is_fall(term, r)
+                fell[i] = info["fell"]
     for env in envs:
         env.close()
     return [
         EpisodeResult(int(s), float(r), int(n), bool(f))
-        for s, r, n, f in zip(seeds, returns, lengths, fell, strict=False)
+        for s, r, n, f in zip(seeds, returns, lengths, fell, strict=True)
     ]
 
 
@@ -84,8 +90,9 @@ def _worker(
     agent_cfg: dict, dims: tuple[int, int], actor_state: dict, env_id: str, seeds: list[int]
 ) -> list[EpisodeResult]:
     torch.set_num_threads(1)
-    actor = _cpu_actor(AgentConfig(**agent_cfg), dims, actor_state)
-    return run_episodes(actor_policy(actor), env_id, seeds)
+    cfg = AgentConfig(**agent_cfg)
+    actor = _cpu_actor(cfg, dims, actor_state)
+    return run_episodes(actor_policy(actor), env_id, seeds, cfg)
 
 
 def evaluate_actor(
@@ -115,7 +122,7 @@ def evaluate_actor(
         torch.set_num_threads(1)  # batch-of-5 inference: more threads only contend
         try:
             for part_seeds in chunks:
-                part = run_episodes(policy, env_id, part_seeds)
+                part = run_episodes(policy, env_id, part_seeds, agent_cfg)
                 results += part
                 if on_episodes:
                     on_episodes(len(part))

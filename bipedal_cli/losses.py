@@ -44,8 +44,12 @@ def truncated_target(
     alpha: torch.Tensor | float,
     gamma: float,
     drop_per_critic: int,
+    discount: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Sorted target atoms y_i = r + gamma (1 - d) (z_(i)(s', a') - alpha log pi(a'|s')).
+
+    n-step transitions (:mod:`bipedal_cli.nstep`) pass ``discount`` (B,) = gamma^m (1 - d) and
+    their summed reward as ``reward``: y_i = R + discount (z_(i) - alpha log pi(a'|s_{t+m})).
 
     next_atoms: (B, N, M) target-critic atoms at (s', a'), a' ~ pi(.|s').
     z_(i) is the i-th smallest of the N*M pooled atoms; the k*N largest are dropped
@@ -53,15 +57,16 @@ def truncated_target(
 
     d is *termination* only (the walker fell or reached the end): a time-limit truncation
     bootstraps, because the state it cuts off still has a future.
-    Returns (B, K), sorted ascending (gamma (1 - d) >= 0 keeps the order).
+    Returns (B, K), sorted ascending (a discount >= 0 keeps the order).
     """
     B, N, M = next_atoms.shape
     kept = N * M - drop_per_critic * N
     pooled = sort_rows(next_atoms.reshape(B, N * M))  # (B, N*M)
     z = pooled[:, :kept]  # (B, K)
     soft_z = z - alpha * next_log_prob.unsqueeze(1)  # (B, K)
-    discount = gamma * (1.0 - terminated.to(z.dtype)).unsqueeze(1)  # (B, 1)
-    return reward.unsqueeze(1) + discount * soft_z  # (B, K)
+    if discount is None:
+        discount = gamma * (1.0 - terminated.to(z.dtype))  # (B,)
+    return reward.unsqueeze(1) + discount.unsqueeze(1) * soft_z  # (B, K)
 
 
 def sort_rows(x: torch.Tensor) -> torch.Tensor:

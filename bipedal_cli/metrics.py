@@ -14,18 +14,21 @@ from .paths import atomic_path
 COLUMNS = [
     "kind",  # episode | eval | full_eval
     "stage",  # env id the row was produced on
-    "step",  # env steps so far
+    "step",  # policy steps so far (transitions stored)
     "episode",  # finished training episodes so far
     "wall_time",  # seconds of training, summed over resumes
     "return",  # episode return, or the mean return of an evaluation
     "return_std",  # evaluation only
-    "length",  # episode length, or mean evaluation episode length
+    "length",  # episode length in env steps, or the mean over an evaluation
     "fell",  # episode ended on the fall penalty (or number of evaluation falls)
     "alpha",
     "critic_loss",
     "actor_loss",
     "entropy",
     "q_mean",
+    "shaped_return",  # training episodes: the return the learner saw (train.fall_penalty and
+    # train.reward_scale); "return" is always the env's own reward
+    "env_steps",  # env steps so far ("step" counts policy steps; they differ with action repeat)
 ]
 METRICS_FILE = "metrics.csv"
 
@@ -36,6 +39,11 @@ class MetricsWriter:
         if not self.path.exists():
             with self.path.open("w", newline="") as f:
                 csv.writer(f).writerow(COLUMNS)
+            return
+        with self.path.open(newline="") as f:
+            header = next(csv.reader(f), [])
+        if header != COLUMNS:  # written by an earlier version: add the new columns, empty
+            self._rewrite(read_metrics(self.path))
 
     def write(self, row: dict[str, Any]) -> None:
         unknown = set(row) - set(COLUMNS)
@@ -47,11 +55,13 @@ class MetricsWriter:
     def truncate_after(self, step: int) -> None:
         """Drop rows logged after ``step`` (written after the checkpoint a resume starts from)."""
         rows = read_metrics(self.path)
-        kept = [r for r in rows if int(float(r["step"])) <= step]
+        self._rewrite([r for r in rows if int(float(r["step"])) <= step])
+
+    def _rewrite(self, rows: list[dict[str, str]]) -> None:
         with atomic_path(self.path) as tmp, tmp.open("w", newline="") as f:
-            w = csv.DictWriter(f, COLUMNS)
+            w = csv.DictWriter(f, COLUMNS, restval="")
             w.writeheader()
-            w.writerows(kept)
+            w.writerows(rows)
 
 
 def _fmt(value: Any) -> Any:

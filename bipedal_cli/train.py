@@ -1,12 +1,15 @@
-"""The training loop: warm-up, one (or more) TQC updates per env step, evaluation, checkpoints.
+"""The training loop: warm-up, one (or more) TQC updates per policy step, evaluation, checkpoints.
 
-A run lives in one directory: ``config.yaml`` (the resolved config), ``metrics.csv``,
+A run lives in one directory (:mod:`bipedal_cli.rundir`): ``config.yaml``, ``metrics.csv``,
 ``state.pt`` (everything an exact resume needs) and ``policy.pt`` (the actor alone).
 
 Exact resume: every source of randomness is one of three checkpointed generators (numpy for
 warm-up actions, episode seeds and replay sampling; a torch generator for exploration noise; the
-global torch RNG), and an episode cut by a checkpoint is rebuilt by resetting its env with the
-episode's seed and replaying the episode's actions (Box2D is deterministic).
+global torch RNG), and an episode cut by a checkpoint is rebuilt by replaying it
+(:mod:`bipedal_cli.episodes`).
+
+``step`` counts policy steps: transitions stored, and updates. With ``agent.action_repeat`` = k
+each is k env steps (fewer at an episode's end); ``env_steps`` counts those.
 """
 
 from __future__ import annotations
@@ -17,13 +20,12 @@ import threading
 import time
 from collections import deque
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
 import torch
-import yaml
 
 from .agent import TQCAgent
 from .buffer import ReplayBuffer
@@ -33,17 +35,15 @@ from .checkpoint import (
     STATE_FILE,
     TRAIN_FORMAT,
     atomic_save,
-    load_checkpoint,
     policy_payload,
 )
-from .config import Config, config_from_dict
-from .envs import env_dims, is_fall, make_env
+from .config import Config
+from .envs import policy_dims
+from .episodes import EpisodeRunner, FinishedEpisode
 from .errors import UserError
 from .evaluation import actor_policy, evaluate_actor, run_episodes, summarize
 from .metrics import METRICS_FILE, MetricsWriter
-
-PLOT_FILE = "learning_curve.png"
-
+from .rundir import default_run_dir, prepare_new_run_dir, write_config, write_plot
 
 class Reporter(Protocol):
     """What the loop tells the outside world; the CLI implements it with rich."""
@@ -80,15 +80,6 @@ def resolve_device(name: str) -> torch.device:
 
 
 @dataclass
-class EpisodeState:
-    """The episode in progress: enough to rebuild the env exactly after a resume."""
-
-    seed: int = 0
-    actions: list[np.ndarray] = field(default_factory=list)
-    ret: float = 0.0
-
-
-@dataclass
 class TrainResult:
     run_dir: Path
     steps: int
@@ -113,19 +104,20 @@ class Trainer:
         # process-wide; see TrainConfig.flush_denormal (measured: benchmarks/throughput.py)
         torch.set_flush_denormal(cfg.train.flush_denormal)
         torch.manual_seed(cfg.seed)
-        self.env = make_env(cfg.env)
-        self.obs_dim, self.act_dim = env_dims(self.env)
+        self.obs_dim, self.act_dim = policy_dims(cfg.env, cfg.agent)
         self.agent = TQCAgent(cfg.agent, self.obs_dim, self.act_dim, self.device)
         if split:
             self.agent.start_worker(cfg.train.flush_denormal)
         self.agent.noise.manual_seed(cfg.seed + 1)
-        self.buffer = ReplayBuffer(cfg.train.buffer_size, self.obs_dim, self.act_dim)
+        self.buffer = ReplayBuffer(
+            cfg.train.buffer_size, self.obs_dim, self.act_dim, with_discount=cfg.agent.n_step > 1
+        )
+        self.runner = EpisodeRunner(cfg, self.buffer)
         self.rng = np.random.default_rng(cfg.seed)
-        self.step = 0
+        self.step = 0  # policy steps
+        self.env_steps = 0
         self.episodes = 0
         self.wall_time = 0.0
-        self.episode = EpisodeState()
-        self.obs: np.ndarray | None = None
         self.recent_returns: deque[float] = deque(maxlen=100)
         self.last_eval: dict | None = None
         self.full_eval: dict | None = None
@@ -148,15 +140,13 @@ class Trainer:
                 k: torch.from_numpy(v) if isinstance(v, np.ndarray) else v
                 for k, v in self.buffer.state_dict().items()
             },
-            "counters": {"step": self.step, "episodes": self.episodes, "wall_time": self.wall_time},
-            "episode": {
-                "seed": self.episode.seed,
-                "actions": torch.from_numpy(
-                    np.array(self.episode.actions, np.float32).reshape(-1, self.act_dim)
-                ),
-                "ret": self.episode.ret,
-                "obs": None if self.obs is None else torch.from_numpy(self.obs.copy()),
+            "counters": {
+                "step": self.step,
+                "env_steps": self.env_steps,
+                "episodes": self.episodes,
+                "wall_time": self.wall_time,
             },
+            "episode": self.runner.state_dict(self.act_dim),
             "recent_returns": list(self.recent_returns),
             "rng": {
                 "numpy": self.rng.bit_generator.state,
@@ -184,6 +174,7 @@ class Trainer:
             int(c["episodes"]),
             c["wall_time"],
         )
+        self.env_steps = int(c.get("env_steps", self.step))
         self.recent_returns = deque(state["recent_returns"], maxlen=100)
         self.rng.bit_generator.state = state["rng"]["numpy"]
         torch.set_rng_state(state["rng"]["torch"])
@@ -195,28 +186,19 @@ class Trainer:
         self._update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
         ep = state["episode"]
         if ep["obs"] is not None:
-            self._replay_episode(int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy())
-            self.episode.ret = float(ep["ret"])
-
-    def _replay_episode(self, seed: int, actions: np.ndarray, expected_obs: np.ndarray) -> None:
-        """Rebuild the interrupted episode: reset with its seed, replay its actions."""
-        self._fresh_env()
-        obs, _ = self.env.reset(seed=seed)
-        for a in actions:
-            obs, *_ = self.env.step(a)
-        if not np.array_equal(obs.astype(np.float32), expected_obs):
-            self.reporter.log(
-                "warning: the replayed episode differs from the checkpoint's; the resumed run "
-                "will not match an uninterrupted one exactly"
-            )
-        self.episode = EpisodeState(seed=seed, actions=list(actions))
-        self.obs = obs.astype(np.float32)
+            rebuilt = self.runner.replay(int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy())
+            if not rebuilt:
+                self.reporter.log(
+                    "warning: the replayed episode differs from the checkpoint's; the resumed "
+                    "run will not match an uninterrupted one exactly"
+                )
 
     def policy_meta(self) -> dict[str, Any]:
         return {
             "env": self.cfg.env,
             "seed": self.cfg.seed,
             "steps": self.step,
+            "env_steps": self.env_steps,
             "episodes": self.episodes,
             "wall_time": round(self.wall_time, 1),
             "last_eval": self.last_eval,
@@ -243,7 +225,7 @@ class Trainer:
         seeds = [self.cfg.train.eval_seed + i for i in range(episodes)]
         policy = actor_policy(self.agent.actor, self.device)
         return summarize(
-            run_episodes(policy, self.cfg.env, seeds),
+            run_episodes(policy, self.cfg.env, seeds, self.cfg.agent),
             self.cfg.train.solved_threshold,
         )
 
@@ -278,7 +260,7 @@ class Trainer:
             t.total_steps = total_steps
         total = t.total_steps
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        (self.run_dir / "config.yaml").write_text(yaml.safe_dump(cfg.to_dict(), sort_keys=False))
+        write_config(self.run_dir, cfg)
         metrics = MetricsWriter(self.run_dir / METRICS_FILE)
         previous = self._install_sigint()
         self.reporter.start(self.step, total)
@@ -287,7 +269,7 @@ class Trainer:
         wall_base = self.wall_time
         rate_t, rate_step = session_start, self.step
         steps_per_s = 0.0
-        if self.obs is None:
+        if self.runner.obs is None:
             self._start_episode()
         try:
             while self.step < total:
@@ -334,18 +316,7 @@ class Trainer:
 
     def write_plot(self) -> Path | None:
         """``learning_curve.png`` in the run directory (skipped before the first episode ends)."""
-        from .plotting import plot_runs
-
-        if self.episodes == 0:
-            return None
-        return plot_runs([self.run_dir], self.run_dir / PLOT_FILE, title=self.run_dir.name)
-
-    def _fresh_env(self) -> None:
-        # A Box2D world keeps history across resets (body and contact ordering), so the same
-        # seed and actions give another trajectory in a reused env. A new env per episode makes
-        # an episode a pure function of (seed, actions): what exact resume relies on.
-        self.env.close()
-        self.env = make_env(self.cfg.env)
+        return write_plot(self.run_dir) if self.episodes else None
 
     def switch_env(self, env_id: str, clear_buffer: bool) -> None:
         """Continue on another env with the same networks, optimizers and temperature.
@@ -353,9 +324,7 @@ class Trainer:
         The episode in progress is dropped (it is not counted); evaluations now use ``env_id``.
         """
         self.cfg.env = env_id
-        probe = make_env(env_id)
-        dims = env_dims(probe)
-        probe.close()
+        dims = policy_dims(env_id, self.cfg.agent)
         if dims != (self.obs_dim, self.act_dim):
             raise UserError(f"{env_id}: observation/action sizes {dims} differ from the agent's")
         if clear_buffer:
@@ -365,37 +334,37 @@ class Trainer:
         self._start_episode()
 
     def _start_episode(self) -> None:
-        seed = int(self.rng.integers(2**31 - 1))
-        self._fresh_env()
-        obs, _ = self.env.reset(seed=seed)
-        self.obs = obs.astype(np.float32)
-        self.episode = EpisodeState(seed=seed)
+        self.runner.start(int(self.rng.integers(2**31 - 1)))
 
     def _env_step(self, metrics: MetricsWriter, wall_base: float, session_start: float) -> None:
         if self.step < self.cfg.train.warmup_steps:
             action = self.rng.uniform(-1.0, 1.0, self.act_dim).astype(np.float32)
         else:
-            action = self.agent.act(self.obs)
-        next_obs, reward, terminated, truncated, _ = self.env.step(action)
-        self.buffer.add(self.obs, action, reward, next_obs, terminated)
-        self.episode.actions.append(action)
-        self.episode.ret += float(reward)
-        self.obs = next_obs.astype(np.float32)
+            action = self.agent.act(self.runner.obs)
+        env_steps_before = self.runner.episode.env_steps
+        finished = self.runner.step(action)
         self.step += 1
-        if terminated or truncated:
-            self.episodes += 1
-            self.recent_returns.append(self.episode.ret)
-            self.wall_time = wall_base + time.perf_counter() - session_start
-            row = {
-                "kind": "episode",
-                "return": self.episode.ret,
-                "length": len(self.episode.actions),
-                "fell": is_fall(terminated, reward),
-                **self._common(),
-                **self._loss_metrics(),
-            }
-            metrics.write(row)
-            self._start_episode()
+        self.env_steps += self.runner.episode.env_steps - env_steps_before
+        if finished is not None:
+            self._finish_episode(finished, metrics, wall_base, session_start)
+
+    def _finish_episode(
+        self, ep: FinishedEpisode, metrics: MetricsWriter, wall_base: float, session_start: float
+    ) -> None:
+        self.episodes += 1
+        self.recent_returns.append(ep.env_ret)
+        self.wall_time = wall_base + time.perf_counter() - session_start
+        row = {
+            "kind": "episode",
+            "return": ep.env_ret,
+            "shaped_return": ep.ret,
+            "length": ep.env_steps,
+            "fell": ep.fell,
+            **self._common(),
+            **self._loss_metrics(),
+        }
+        metrics.write(row)
+        self._start_episode()
 
     def _loss_metrics(self) -> dict[str, float]:
         m = self._update_metrics
@@ -410,6 +379,7 @@ class Trainer:
         return {
             "stage": self.cfg.env,
             "step": self.step,
+            "env_steps": self.env_steps,
             "episode": self.episodes,
             "wall_time": round(self.wall_time, 2),
         }
@@ -463,25 +433,6 @@ class Trainer:
         }
 
 
-def prepare_new_run_dir(run_dir: str | Path, option: str = "--run-dir") -> Path:
-    run_dir = Path(run_dir)
-    if (run_dir / STATE_FILE).exists() or (run_dir / METRICS_FILE).exists():
-        raise UserError(
-            f"{option} {run_dir}: already holds a run; continue it with `bipedal resume "
-            f"{run_dir}` or choose another directory"
-        )
-    if run_dir.exists() and not run_dir.is_dir():
-        raise UserError(f"{option} {run_dir}: exists and is not a directory")
-    return run_dir
-
-
-def default_run_dir(cfg: Config, kind: str | None = None, root: str | Path = "runs") -> Path:
-    """``runs/<kind>-seed<S>-<time>``; kind defaults to walker or hardcore."""
-    kind = kind or ("hardcore" if "Hardcore" in cfg.env else "walker")
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    return Path(root) / f"{kind}-seed{cfg.seed}-{stamp}"
-
-
 def train(
     cfg: Config,
     run_dir: str | Path | None = None,
@@ -492,52 +443,3 @@ def train(
     run_dir = prepare_new_run_dir(run_dir or default_run_dir(cfg))
     trainer = Trainer(cfg, run_dir, reporter)
     return trainer.run(until_solved=until_solved)
-
-
-def load_trainer(
-    path: str | Path, reporter: Reporter | None = None, device: str | None = None
-) -> Trainer:
-    """A Trainer restored from ``path`` (a run directory or its ``state.pt``), ready to run."""
-    path = Path(path)
-    state_path = path / STATE_FILE if path.is_dir() else path
-    if path.is_dir() and not state_path.exists():
-        raise UserError(f"RUN_DIR {path}: holds no {STATE_FILE}; nothing to resume")
-    state = load_checkpoint(state_path, "RUN_DIR_OR_CHECKPOINT")
-    if state["format"] != TRAIN_FORMAT:
-        raise UserError(
-            f"RUN_DIR_OR_CHECKPOINT {state_path}: a policy-only checkpoint cannot be resumed; "
-            f"expected the run's {STATE_FILE}"
-        )
-    cfg = config_from_dict(state["config"], f"{state_path}: config")
-    if device:
-        cfg.device = device
-    trainer = Trainer(cfg, state_path.parent, reporter)
-    trainer.load_state_dict(state)
-    metrics_path = state_path.parent / METRICS_FILE
-    if metrics_path.exists():
-        MetricsWriter(metrics_path).truncate_after(trainer.step)
-    return trainer
-
-
-def resume(
-    path: str | Path,
-    total_steps: int | None = None,
-    reporter: Reporter | None = None,
-    until_solved: bool = False,
-    device: str | None = None,
-):
-    """Continue the run at ``path``; a curriculum run continues inside its current stage.
-
-    Returns a :class:`TrainResult`, or a ``CurriculumResult`` for a curriculum run.
-    """
-    trainer = load_trainer(path, reporter, device)
-    if trainer.curriculum is not None:
-        from .curriculum import continue_curriculum
-
-        if total_steps is not None:
-            raise UserError(
-                "--steps: a curriculum run takes its budgets from its config "
-                "(curriculum.walker_steps, curriculum.hardcore_steps)"
-            )
-        return continue_curriculum(trainer)
-    return trainer.run(total_steps=total_steps, until_solved=until_solved)

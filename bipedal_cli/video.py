@@ -13,7 +13,8 @@ import imageio.v2 as imageio
 import numpy as np
 from PIL import Image, ImageDraw
 
-from .envs import is_fall, make_env
+from .config import AgentConfig
+from .envs import make_policy_env
 from .evaluation import EpisodeResult
 from .paths import atomic_path
 
@@ -55,42 +56,50 @@ def record(
     frame_step: int = 1,
     scale: float = 1.0,
     on_frame: Callable[[], None] | None = None,
+    agent_cfg: AgentConfig | None = None,
 ) -> tuple[list[EpisodeResult], int, float]:
     """Play one episode per seed and write every ``frame_step``-th frame (scaled) to ``out``.
 
-    Returns the episodes, the number of frames written and the frame rate. The file appears
-    atomically: frames go to a temporary file that is renamed over ``out`` at the end.
+    The env is the policy's (``agent_cfg``'s action repeat and history), with a frame per env
+    step, also inside an action repeat. Returns the episodes, the number of frames written and
+    the frame rate. The file appears atomically: frames go to a temporary file that is renamed
+    over ``out`` at the end.
     """
-    env = make_env(env_id, render=True)
+    episode = {"label": "", "ret": 0.0, "t": 0}
+
+    def on_env_step(env_reward: float) -> None:
+        episode["ret"] += env_reward
+        episode["t"] += 1
+        if episode["t"] % frame_step == 0:
+            grab()
+
+    def grab() -> None:
+        frame = env.render()
+        if scale != 1.0:
+            h, w = frame.shape[:2]
+            size = (2 * round(w * scale / 2), 2 * round(h * scale / 2))
+            frame = np.asarray(Image.fromarray(frame).resize(size))
+        writer.append_data(caption(frame, f"{episode['label']}  return {episode['ret']:7.1f}"))
+        counts["frames"] += 1
+        if on_frame:
+            on_frame()
+
+    env = make_policy_env(env_id, agent_cfg or AgentConfig(), True, on_env_step)
     fps = float(fps or env.metadata.get("render_fps", 50)) / (1 if fps else frame_step)
     episodes: list[EpisodeResult] = []
-    frames = 0
+    counts = {"frames": 0}
     try:
         with atomic_path(out) as tmp, _writer(tmp, fps) as writer:
             for k, seed in enumerate(seeds):
                 obs, _ = env.reset(seed=seed)
-                ret, length, done, t = 0.0, 0, False, 0
-                while True:
-                    if t % frame_step == 0:
-                        frame = env.render()
-                        if scale != 1.0:
-                            h, w = frame.shape[:2]
-                            size = (2 * round(w * scale / 2), 2 * round(h * scale / 2))
-                            frame = np.asarray(Image.fromarray(frame).resize(size))
-                        label = f"episode {k + 1}/{len(seeds)}  seed {seed}  return {ret:7.1f}"
-                        writer.append_data(caption(frame, label))
-                        frames += 1
-                    if on_frame:
-                        on_frame()
-                    if done:
-                        break
+                episode.update(label=f"episode {k + 1}/{len(seeds)}  seed {seed}", ret=0.0, t=0)
+                grab()
+                done = False
+                while not done:
                     action = policy(obs[None].astype(np.float32))[0]
-                    obs, r, term, trunc, _ = env.step(action)
-                    ret += float(r)
-                    length += 1
-                    t += 1
+                    obs, _, term, trunc, info = env.step(action)
                     done = term or trunc
-                episodes.append(EpisodeResult(seed, ret, length, is_fall(term, r)))
+                episodes.append(EpisodeResult(seed, episode["ret"], episode["t"], info["fell"]))
     finally:
         env.close()
-    return episodes, frames, fps
+    return episodes, counts["frames"], fps

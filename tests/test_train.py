@@ -6,7 +6,8 @@ import torch
 
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict
-from bipedal_cli.train import resume, train
+from bipedal_cli.resume import resume
+from bipedal_cli.train import train
 
 from .conftest import tiny_dict
 

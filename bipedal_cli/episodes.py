@@ -1,0 +1,125 @@
+"""The training env and the episode in progress: stepping, storing transitions, exact rebuild.
+
+An episode is a pure function of its env seed and its actions: each episode gets a new env (a
+reused Box2D world keeps history across resets: body and contact ordering), so resetting a fresh
+env with the seed and replaying the actions rebuilds it exactly, wrappers' state included (the
+observation history, the pending n-step steps). That is what exact resume relies on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .buffer import ReplayBuffer
+from .config import Config
+from .envs import make_env
+from .nstep import NStepAccumulator
+
+
+@dataclass
+class EpisodeState:
+    """The episode in progress: enough to rebuild the env exactly after a resume."""
+
+    seed: int = 0
+    actions: list[np.ndarray] = field(default_factory=list)
+    ret: float = 0.0  # the learner's return (shaped rewards)
+    env_ret: float = 0.0  # the env's own return
+    env_steps: int = 0  # env steps (action repeat: several per action)
+
+
+@dataclass
+class FinishedEpisode:
+    ret: float
+    env_ret: float
+    env_steps: int
+    fell: bool
+
+
+class EpisodeRunner:
+    """Steps the training env (shaping, action repeat, history as configured) and writes each
+    transition to the replay buffer, through an n-step accumulator when ``agent.n_step`` > 1."""
+
+    def __init__(self, cfg: Config, buffer: ReplayBuffer) -> None:
+        self.cfg, self.buffer = cfg, buffer
+        n = cfg.agent.n_step
+        self.nstep = NStepAccumulator(n, cfg.agent.gamma) if n > 1 else None
+        self.env = self._make_env()
+        self.episode = EpisodeState()
+        self.obs: np.ndarray | None = None  # None: no episode in progress
+
+    def _make_env(self):
+        a, t = self.cfg.agent, self.cfg.train
+        return make_env(
+            self.cfg.env,
+            action_repeat=a.action_repeat,
+            history=a.history,
+            fall_penalty=t.fall_penalty,
+            reward_scale=t.reward_scale,
+        )
+
+    def _fresh_env(self) -> None:
+        self.env.close()
+        self.env = self._make_env()  # follows cfg.env, which a curriculum switches
+
+    def start(self, seed: int) -> None:
+        """A new episode on a new env reset with ``seed``."""
+        self._fresh_env()
+        obs, _ = self.env.reset(seed=seed)
+        self.obs = obs.astype(np.float32)
+        self.episode = EpisodeState(seed=seed)
+        if self.nstep is not None:
+            self.nstep.reset()
+
+    def step(self, action: np.ndarray) -> FinishedEpisode | None:
+        """One policy step: env step(s), the transition stored; the result when it ended."""
+        next_obs, reward, terminated, truncated, info = self.env.step(action)
+        self._store(action, reward, next_obs, terminated, truncated)
+        self._account(action, reward, info)
+        self.obs = next_obs.astype(np.float32)
+        if terminated or truncated:
+            e = self.episode
+            return FinishedEpisode(e.ret, e.env_ret, e.env_steps, bool(info["fell"]))
+        return None
+
+    def _account(self, action: np.ndarray, reward: float, info: dict) -> None:
+        e = self.episode
+        e.actions.append(action)
+        e.ret += float(reward)
+        e.env_ret += float(info["env_reward"])
+        e.env_steps += int(info["env_steps"])
+
+    def _store(self, action, reward, next_obs, terminated: bool, truncated: bool) -> None:
+        if self.nstep is None:  # terminated, never truncated: a truncation bootstraps
+            self.buffer.add(self.obs, action, reward, next_obs, terminated)
+            return
+        for tr in self.nstep.push(self.obs, action, reward, next_obs, terminated, truncated):
+            self.buffer.add(tr.obs, tr.action, tr.reward, tr.next_obs, tr.terminated, tr.discount)
+
+    def replay(self, seed: int, actions: np.ndarray, expected_obs: np.ndarray) -> bool:
+        """Rebuild an interrupted episode (its transitions are in the buffer already);
+        False when the rebuilt observation differs from ``expected_obs``."""
+        self.start(seed)
+        for action in actions:
+            next_obs, reward, terminated, truncated, info = self.env.step(action)
+            if self.nstep is not None:  # the pending steps only; what it returns is stored
+                self.nstep.push(self.obs, action, reward, next_obs, terminated, truncated)
+            self._account(action, reward, info)
+            self.obs = next_obs.astype(np.float32)
+        return bool(np.array_equal(self.obs, expected_obs))
+
+    def state_dict(self, act_dim: int) -> dict:
+        import torch
+
+        e = self.episode
+        return {
+            "seed": e.seed,
+            "actions": torch.from_numpy(np.array(e.actions, np.float32).reshape(-1, act_dim)),
+            "ret": e.ret,
+            "env_ret": e.env_ret,
+            "obs": None if self.obs is None else torch.from_numpy(self.obs.copy()),
+        }
+
+    def close(self) -> None:
+        self.env.close()
