@@ -70,3 +70,22 @@ def ref_temperature_loss(log_alpha, log_prob, target_entropy):
     for b in range(B):
         total = total + log_alpha * (-log_prob[b].item() - target_entropy)
     return total / B
+
+
+def ref_nstep_target(next_atoms, rewards, n, gamma, end, terminated_at_end, next_log_prob, alpha, k, t):
+    """The n-step target of the transition at time t of one episode, straight from its definition.
+
+    rewards: the episode's one-step rewards r_0..r_{T-1}; the episode ends after step ``end``
+    (= T - 1), terminated or truncated. m = min(n, T - t) rewards are summed; the bootstrap at
+    s_{t+m} is cut only when the episode terminated within them:
+
+        y_i = sum_{j<m} gamma^j r_{t+j} + gamma^m (1 - d) (z_(i) - alpha log pi(a'|s_{t+m}))
+    """
+    T = end + 1
+    m = min(n, T - t)
+    ret = sum(gamma**j * float(rewards[t + j]) for j in range(m))
+    d = 1.0 if (terminated_at_end and t + m == T) else 0.0
+    N, M = next_atoms.shape
+    pooled = sorted([next_atoms[i, j] for i in range(N) for j in range(M)], key=float)
+    kept = pooled[: N * M - k * N]
+    return torch.stack([ret + gamma**m * (1.0 - d) * (z - alpha * next_log_prob) for z in kept])
