@@ -9,6 +9,8 @@ kill at any moment leaves the previous checkpoint intact.
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -28,10 +30,25 @@ def atomic_save(obj: Any, path: str | Path) -> None:
     """torch.save to ``path`` through a temporary file, fsync and ``os.replace``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+    with _write_errors(path), atomic_path(path) as tmp, open(tmp, "wb") as f:
         torch.save(obj, f)
         f.flush()
         os.fsync(f.fileno())
+
+
+@contextmanager
+def _write_errors(path: Path) -> Iterator[None]:
+    """A failed write (a full disk: ``OSError`` or torch's ``RuntimeError``) as one line naming
+    the file; the file itself is untouched, since the data went to a temporary file."""
+    try:
+        yield
+    except (OSError, RuntimeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else "write failed"
+        if isinstance(exc, RuntimeError) and "No space" not in str(exc):
+            reason = f"write failed: {str(exc).splitlines()[0][:80]}"
+        raise UserError(
+            f"{path}: could not be written ({reason}); the previous version is intact"
+        ) from None
 
 
 def load_checkpoint(path: str | Path, option: str = "CKPT") -> dict[str, Any]:
@@ -56,11 +73,17 @@ def load_checkpoint(path: str | Path, option: str = "CKPT") -> dict[str, Any]:
             f"{option} {path}: not a bipedal checkpoint; expected a policy.pt or state.pt "
             "written by `bipedal train`"
         )
-    if int(data.get("version", -1)) > FORMAT_VERSION:
+    version = data.get("version")
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise UserError(f"{option} {path}: format version {version!r}; expected a positive integer")
+    if version > FORMAT_VERSION:
         raise UserError(
-            f"{option} {path}: checkpoint format version {data.get('version')} is newer than "
+            f"{option} {path}: checkpoint format version {version} is newer than "
             f"this bipedal supports ({FORMAT_VERSION}); upgrade bipedal"
         )
+    from .schema import check_checkpoint
+
+    check_checkpoint(data, f"{option} {path}")
     data["path"] = str(path)
     return data
 
@@ -108,5 +131,5 @@ def check_dims(data: dict[str, Any], obs_dim: int, act_dim: int, env_id: str, op
 
 def atomic_write_text(path: str | Path, text: str) -> None:
     """Write a text file (JSON reports) through a temporary file and ``os.replace``."""
-    with atomic_path(path) as tmp:
+    with _write_errors(Path(path)), atomic_path(path) as tmp:
         Path(tmp).write_text(text)

@@ -6,6 +6,7 @@ Every :class:`UserError` (and every usage error) becomes one line on stderr and 
 from __future__ import annotations
 
 import json
+import math
 import sys
 import time
 from pathlib import Path
@@ -14,9 +15,9 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from .config import canonical_env_id, resolve_config
+from .config import canonical_env_id, check_count, check_seeds, resolve_config
 from .errors import UserError
-from .paths import check_output_path
+from .paths import check_output_path, printable
 
 app = typer.Typer(
     add_completion=False,
@@ -47,7 +48,7 @@ def _summary_line(result) -> str:
     }[result.stopped]
     return (
         f"{why}: {result.steps:,} env steps, {result.episodes:,} episodes, "
-        f"{minutes:.1f} min; run directory {result.run_dir}"
+        f"{minutes:.1f} min; run directory {printable(result.run_dir)}"
     )
 
 
@@ -64,9 +65,8 @@ def _report_result(result) -> None:
             f"last evaluation ({e['episodes']} episodes at step {e['step']:,}): "
             f"{e['mean']:.1f} +- {e['std']:.1f}"
         )
-    console.print(
-        f"policy: {result.run_dir / 'policy.pt'}   resume: bipedal resume {result.run_dir}"
-    )
+    run_dir = printable(result.run_dir)
+    console.print(f"policy: {run_dir}/policy.pt   resume: bipedal resume {run_dir}")
 
 
 @app.command()
@@ -103,10 +103,17 @@ def train(
             "train.total_steps": steps,
         },
     )
-    if steps is not None and steps < 0:
-        raise UserError("--steps: expected a non-negative integer")
     result = train_run(cfg, run_dir, TrainingDisplay(console, cfg.env), until_solved)
     _report_result(result)
+    _exit_if_interrupted(result)
+
+
+def _exit_if_interrupted(result) -> None:
+    """128 + the signal's number after a run stopped by Ctrl-C (130) or SIGTERM (143)."""
+    if result.signal is not None:
+        from .signals import exit_status
+
+        sys.exit(exit_status(result.signal))
 
 
 @app.command()
@@ -119,19 +126,28 @@ def resume(
     ] = None,
     until_solved: Annotated[bool, typer.Option("--until-solved")] = False,
     device: DeviceOpt = None,
+    threads: Annotated[
+        int | None,
+        typer.Option("--threads", help="CPU threads from now on (0: every core; same results)."),
+    ] = None,
 ) -> None:
     """Continue a run exactly where its last checkpoint left it."""
     from .display import TrainingDisplay
-    from .train import resolve_device
     from .resume import resume as resume_run
+    from .train import resolve_device
 
+    if steps is not None and steps < 0:
+        raise UserError(f"--steps {steps}: expected the new total, a non-negative integer")
     if device:
         resolve_device(device)
-    result = resume_run(run, steps, TrainingDisplay(console, "resume"), until_solved, device)
+    result = resume_run(
+        run, steps, TrainingDisplay(console, "resume"), until_solved, device, threads
+    )
     if hasattr(result, "stages"):
         _report_curriculum(result)
     else:
         _report_result(result)
+    _exit_if_interrupted(result)
 
 
 @app.command("eval")
@@ -153,8 +169,8 @@ def eval_(
     from .display import eval_table, verdict
     from .evaluation import evaluate_actor, summarize
 
-    if episodes < 1:
-        raise UserError("--episodes: expected a positive integer")
+    check_count("--episodes", episodes)
+    check_seeds("--seed", seed, episodes)
     if workers < 0:
         raise UserError("--workers: expected 0 (every core) or a positive integer")
     if json_out is not None:
@@ -233,15 +249,17 @@ def record(
     from .video import record as record_video
 
     check_output_path(out, "--out", VIDEO_SUFFIXES, force)
-    if episodes < 1:
-        raise UserError("--episodes: expected a positive integer")
-    if fps is not None and fps <= 0:
-        raise UserError("--fps: expected a positive number")
+    check_count("--episodes", episodes, 1000)
+    check_seeds("--seed", seed, episodes)
+    if fps is not None and not (math.isfinite(fps) and 0 < fps <= 1000):
+        raise UserError(f"--fps {fps}: expected a frame rate in (0, 1000]")
+    if frame_step is not None and not 1 <= frame_step <= 1000:
+        raise UserError(f"--frame-step {frame_step}: expected an integer in [1, 1000]")
+    if scale is not None and not (math.isfinite(scale) and 0 < scale <= 4):
+        raise UserError(f"--scale {scale}: expected a number in (0, 4]")
     gif = out.suffix.lower() == ".gif"
     frame_step = frame_step or (2 if gif else 1)
     scale = scale or (0.5 if gif else 1.0)
-    if frame_step < 1 or not 0 < scale <= 4:
-        raise UserError("--frame-step/--scale: expected a positive step and a scale in (0, 4]")
     import gymnasium
 
     data, actor, cfg, env_id = _load_policy(ckpt, env)
@@ -310,12 +328,13 @@ def curriculum(
     )
     result = start_curriculum(cfg, run_dir, TrainingDisplay(console, "curriculum"))
     _report_curriculum(result)
+    _exit_if_interrupted(result)
 
 
 def _report_curriculum(result) -> None:
     from rich.table import Table
 
-    table = Table(title=f"curriculum ({result.stopped}): {result.run_dir}")
+    table = Table(title=f"curriculum ({result.stopped}): {printable(result.run_dir)}")
     for col in ("stage", "env", "steps", "episodes", "wall time", "evaluation", "result"):
         table.add_column(col, justify="right")
     for i, st in enumerate(result.stages, 1):
@@ -331,7 +350,7 @@ def _report_curriculum(result) -> None:
             st["stopped"],
         )
     console.print(table)
-    console.print(f"resume: bipedal resume {result.run_dir}")
+    console.print(f"resume: bipedal resume {printable(result.run_dir)}")
 
 
 @app.command()

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from .config import ENV_ALIASES, Config
-from .rundir import default_run_dir, prepare_new_run_dir
+from .rundir import default_run_dir, lock_run_dir, prepare_new_run_dir
 from .train import Reporter, Trainer, TrainResult
 
 STAGES = (ENV_ALIASES["walker"], ENV_ALIASES["hardcore"])
@@ -25,6 +25,7 @@ class CurriculumResult:
     run_dir: Path
     stages: list[dict[str, Any]]  # per finished stage: env, steps, episodes, wall_time, eval
     stopped: str
+    signal: int | None = None  # the signal that interrupted it
 
 
 def _stage_summary(trainer: Trainer, result: TrainResult, start: dict[str, float]) -> dict:
@@ -53,7 +54,9 @@ def new_curriculum_trainer(
 def start_curriculum(
     cfg: Config, run_dir: str | Path | None = None, reporter: Reporter | None = None
 ) -> CurriculumResult:
-    return continue_curriculum(new_curriculum_trainer(cfg, run_dir, reporter))
+    run_dir = prepare_new_run_dir(run_dir or default_run_dir(cfg, "curriculum"))
+    with lock_run_dir(run_dir):
+        return continue_curriculum(new_curriculum_trainer(cfg, run_dir, reporter))
 
 
 def _counters(trainer: Trainer) -> dict[str, float]:
@@ -71,8 +74,9 @@ def continue_curriculum(trainer: Trainer) -> CurriculumResult:
         start = state["stage_start"]
         result = trainer.run(total_steps=int(start["step"]) + budgets[stage], until_solved=True)
         if result.stopped == "interrupted":
-            stopped = "interrupted"
-            break
+            return CurriculumResult(
+                trainer.run_dir, list(state["finished"]), "interrupted", result.signal
+            )
         state["finished"].append(_stage_summary(trainer, result, start))
         stopped = result.stopped
         state["stage"] = stage + 1

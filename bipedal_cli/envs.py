@@ -60,21 +60,24 @@ class ActionRepeat(gym.Wrapper):
     ``info['env_reward']`` are the sums over those steps, ``info['env_steps']`` their number.
     ``on_env_step(env_reward)`` is called after each of them."""
 
-    def __init__(self, env: gym.Env, repeat: int, on_env_step: Callable[[float], None] | None = None):
+    def __init__(
+        self, env: gym.Env, repeat: int, on_env_step: Callable[[float], None] | None = None
+    ):
         super().__init__(env)
         self.repeat, self.on_env_step = repeat, on_env_step
 
     def step(self, action):
-        reward_sum, env_reward_sum = 0.0, 0.0
-        for n in range(1, self.repeat + 1):
+        reward_sum, env_reward_sum, steps = 0.0, 0.0, 0
+        while steps < self.repeat:
             obs, reward, terminated, truncated, info = self.env.step(action)
+            steps += 1
             reward_sum += float(reward)
             env_reward_sum += float(info.get("env_reward", reward))
             if self.on_env_step is not None:  # recording: a frame per env step
                 self.on_env_step(float(info.get("env_reward", reward)))
             if terminated or truncated:
                 break
-        info = {**info, "env_reward": env_reward_sum, "env_steps": n}
+        info = {**info, "env_reward": env_reward_sum, "env_steps": steps}
         return obs, reward_sum, terminated, truncated, info
 
 

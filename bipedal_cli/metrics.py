@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import csv
+import io
 import math
+import os
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .errors import UserError
 from .paths import atomic_path
 
 COLUMNS = [
@@ -36,6 +39,11 @@ METRICS_FILE = "metrics.csv"
 class MetricsWriter:
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
+        if self.path.is_symlink():
+            raise UserError(
+                f"{self.path}: is a symbolic link; a run's metrics must be a regular file "
+                "(bipedal never writes through a link)"
+            )
         if not self.path.exists():
             with self.path.open("w", newline="") as f:
                 csv.writer(f).writerow(COLUMNS)
@@ -49,8 +57,14 @@ class MetricsWriter:
         unknown = set(row) - set(COLUMNS)
         if unknown:
             raise KeyError(f"unknown metric columns {sorted(unknown)}")
-        with self.path.open("a", newline="") as f:
-            csv.writer(f).writerow([_fmt(row.get(c, "")) for c in COLUMNS])
+        line = io.StringIO()
+        csv.writer(line).writerow([_fmt(row.get(c, "")) for c in COLUMNS])
+        try:  # O_NOFOLLOW: never through a link
+            fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_NOFOLLOW)
+            with os.fdopen(fd, "w", newline="") as f:
+                f.write(line.getvalue())
+        except OSError as exc:
+            raise UserError(f"{self.path}: could not be written ({exc.strerror})") from None
 
     def truncate_after(self, step: int) -> None:
         """Drop rows logged after ``step`` (written after the checkpoint a resume starts from)."""
@@ -73,5 +87,16 @@ def _fmt(value: Any) -> Any:
 
 
 def read_metrics(path: str | Path) -> list[dict[str, str]]:
-    with Path(path).open(newline="") as f:
-        return list(csv.DictReader(f))
+    """The rows of a metrics file; a torn row (a full disk or a power loss mid-write: too few
+    fields or an unreadable step) is dropped."""
+    with Path(path).open(newline="", errors="replace") as f:
+        return [r for r in csv.DictReader(f) if _complete(r)]
+
+
+def _complete(row: dict) -> bool:
+    if None in row or any(v is None for v in row.values()):  # too many or too few fields
+        return False
+    try:
+        return math.isfinite(float(row["step"])) and row["kind"] in ("episode", "eval", "full_eval")
+    except (KeyError, ValueError):
+        return False

@@ -11,6 +11,11 @@ from pathlib import Path
 from .errors import UserError
 
 
+def printable(name: str | Path) -> str:
+    """A path as text that can be printed or drawn: bytes that are not UTF-8 become U+FFFD."""
+    return os.fsencode(str(name)).decode("utf-8", "replace")
+
+
 def check_output_path(
     path: Path, option: str, suffixes: tuple[str, ...] | None = None, force: bool = True
 ) -> None:

@@ -9,7 +9,7 @@ import numpy as np
 
 from .errors import UserError
 from .metrics import METRICS_FILE, read_metrics
-from .paths import atomic_path
+from .paths import atomic_path, printable
 
 PLOT_SUFFIXES = (".png", ".svg")
 PLOT_METRICS = ("return", "alpha", "critic_loss", "actor_loss", "entropy", "q_mean", "length")
@@ -54,7 +54,7 @@ def load_run(run_dir: str | Path, label: str | None = None, metric: str = "retur
     for r in episodes:
         if not stages or stages[-1][0] != r["stage"]:
             stages.append((r["stage"], int(float(r["step"]))))
-    name = label or (run_dir.name if run_dir.is_dir() else run_dir.parent.name)
+    name = label or printable(run_dir.name if run_dir.is_dir() else run_dir.parent.name)
     if metric != "return":
         eval_steps, eval_means = np.zeros(0), np.zeros(0)
     return RunCurve(name, steps, values, eval_steps, eval_means, stages)

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import os
 import signal
-import threading
 import time
 from collections import deque
 from collections.abc import Mapping
@@ -43,7 +42,16 @@ from .episodes import EpisodeRunner, FinishedEpisode
 from .errors import UserError
 from .evaluation import actor_policy, evaluate_actor, run_episodes, summarize
 from .metrics import METRICS_FILE, MetricsWriter
-from .rundir import default_run_dir, prepare_new_run_dir, write_config, write_plot
+from .rundir import (
+    default_run_dir,
+    lock_run_dir,
+    prepare_new_run_dir,
+    remove_stale_temporaries,
+    write_config,
+    write_plot,
+)
+from .signals import stop_on_signals
+
 
 class Reporter(Protocol):
     """What the loop tells the outside world; the CLI implements it with rich."""
@@ -88,6 +96,7 @@ class TrainResult:
     stopped: str  # "budget" | "solved" | "interrupted"
     last_eval: dict | None
     full_eval: dict | None
+    signal: int | None = None  # the signal that interrupted it
 
 
 class Trainer:
@@ -124,7 +133,7 @@ class Trainer:
         self.last_metrics: dict[str, float] = {}
         self._update_metrics: Mapping[str, torch.Tensor] | None = None  # last update's, unsynced
         self.curriculum: dict[str, Any] | None = None  # set by curriculum.py
-        self._stop_requested = False
+        self._stop_signal: int | None = None  # set by request_stop
 
     # ----------------------------------------------------------------- state
     def state_dict(self) -> dict[str, Any]:
@@ -206,7 +215,20 @@ class Trainer:
             "torch": str(torch.__version__),
         }
 
+    def _diverged(self, what: str) -> UserError:
+        saved = self.run_dir / STATE_FILE
+        return UserError(
+            f"training diverged at step {self.step:,}: {what} is not finite (NaN or inf); "
+            f"{saved} keeps the last good checkpoint"
+        )
+
     def save(self) -> None:
+        """state.pt and policy.pt; refused (the last good ones kept) when a network holds NaN."""
+        self.agent.sync()
+        for name in ("actor", "critic"):
+            params = getattr(self.agent, name).parameters()
+            if not all(bool(torch.isfinite(p).all()) for p in params):
+                raise self._diverged(f"the {name}'s weights")
         atomic_save(self.state_dict(), self.run_dir / STATE_FILE)
         self.save_policy(self.run_dir / POLICY_FILE)
 
@@ -238,31 +260,45 @@ class Trainer:
         return summary
 
     # ------------------------------------------------------------------ loop
-    def request_stop(self) -> None:
-        """Stop after the current env step, with a checkpoint (what the first Ctrl-C does)."""
-        self._stop_requested = True
-
-    def _install_sigint(self):
-        if threading.current_thread() is not threading.main_thread():
-            return None
-
-        def handler(signum, frame):
-            if self._stop_requested:  # second Ctrl-C: stop now
-                raise KeyboardInterrupt
-            self.request_stop()
-            self.reporter.log("Ctrl-C: saving a checkpoint and stopping (again to abort)")
-
-        return signal.signal(signal.SIGINT, handler)
+    def request_stop(self, signum: int = signal.SIGINT) -> None:
+        """Stop after the current env step, with a checkpoint (the first Ctrl-C or SIGTERM)."""
+        self._stop_signal = signum
+        name = "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
+        self.reporter.log(f"{name}: saving a checkpoint and stopping (again to abort)")
 
     def run(self, total_steps: int | None = None, until_solved: bool = False) -> TrainResult:
+        """Train until the budget (``total_steps``, or the config's), a stop signal or, with
+        ``until_solved``, a passed 100-episode test; checkpoint and return."""
         cfg, t = self.cfg, self.cfg.train
         if total_steps is not None:  # `resume --steps N` moves the budget; the config says so
             t.total_steps = total_steps
         total = t.total_steps
         self.run_dir.mkdir(parents=True, exist_ok=True)
+        remove_stale_temporaries(self.run_dir)
         write_config(self.run_dir, cfg)
+        if not (self.run_dir / STATE_FILE).exists():
+            self.save()  # step 0: a run killed before its first periodic checkpoint resumes
         metrics = MetricsWriter(self.run_dir / METRICS_FILE)
-        previous = self._install_sigint()
+        with stop_on_signals(self.request_stop):
+            stopped, steps_per_s = self._loop(metrics, total, until_solved)
+        self.save()
+        self.write_plot()
+        self.reporter.update(self.snapshot(steps_per_s))
+        self.reporter.close()
+        return TrainResult(
+            self.run_dir,
+            self.step,
+            self.episodes,
+            self.wall_time,
+            stopped,
+            self.last_eval,
+            self.full_eval,
+            self._stop_signal if stopped == "interrupted" else None,
+        )
+
+    def _loop(self, metrics: MetricsWriter, total: int, until_solved: bool) -> tuple[str, float]:
+        """Env steps and updates until the budget, a stop request or a solved test."""
+        cfg, t = self.cfg, self.cfg.train
         self.reporter.start(self.step, total)
         stopped = "budget"
         session_start = time.perf_counter()
@@ -273,7 +309,7 @@ class Trainer:
             self._start_episode()
         try:
             while self.step < total:
-                if self._stop_requested:
+                if self._stop_signal is not None:
                     stopped = "interrupted"
                     break
                 self._env_step(metrics, wall_base, session_start)
@@ -298,21 +334,7 @@ class Trainer:
                     self.reporter.update(self.snapshot(steps_per_s))
         finally:
             self.wall_time = wall_base + time.perf_counter() - session_start
-            if previous is not None:
-                signal.signal(signal.SIGINT, previous)
-        self.save()
-        self.write_plot()
-        self.reporter.update(self.snapshot(steps_per_s))
-        self.reporter.close()
-        return TrainResult(
-            self.run_dir,
-            self.step,
-            self.episodes,
-            self.wall_time,
-            stopped,
-            self.last_eval,
-            self.full_eval,
-        )
+        return stopped, steps_per_s
 
     def write_plot(self) -> Path | None:
         """``learning_curve.png`` in the run directory (skipped before the first episode ends)."""
@@ -341,6 +363,8 @@ class Trainer:
             action = self.rng.uniform(-1.0, 1.0, self.act_dim).astype(np.float32)
         else:
             action = self.agent.act(self.runner.obs)
+            if not np.isfinite(action).all():  # Box2D must never see a NaN action
+                raise self._diverged("the policy's action")
         env_steps_before = self.runner.episode.env_steps
         finished = self.runner.step(action)
         self.step += 1
@@ -441,5 +465,7 @@ def train(
 ) -> TrainResult:
     """Start a new run in ``run_dir`` (default ``runs/<env>-seed<S>-<time>``) and train it."""
     run_dir = prepare_new_run_dir(run_dir or default_run_dir(cfg))
-    trainer = Trainer(cfg, run_dir, reporter)
-    return trainer.run(until_solved=until_solved)
+    with lock_run_dir(run_dir):
+        prepare_new_run_dir(run_dir)  # again, now that no other process can start one there
+        trainer = Trainer(cfg, run_dir, reporter)
+        return trainer.run(until_solved=until_solved)

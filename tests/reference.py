@@ -72,7 +72,9 @@ def ref_temperature_loss(log_alpha, log_prob, target_entropy):
     return total / B
 
 
-def ref_nstep_target(next_atoms, rewards, n, gamma, end, terminated_at_end, next_log_prob, alpha, k, t):
+def ref_nstep_target(
+    next_atoms, rewards, n, gamma, end, terminated_at_end, next_log_prob, alpha, k, t
+):
     """The n-step target of the transition at time t of one episode, straight from its definition.
 
     rewards: the episode's one-step rewards r_0..r_{T-1}; the episode ends after step ``end``

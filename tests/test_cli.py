@@ -1,6 +1,8 @@
 import json
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 import torch
@@ -163,10 +165,11 @@ def test_console_script_reports_errors_without_traceback(tmp_path):
     assert proc.stderr.strip() == f"bipedal: error: CKPT {tmp_path / 'missing.pt'}: no such file"
 
 
-def test_ctrl_c_saves_a_checkpoint_and_exits_cleanly(tmp_path, tiny_yaml):
-    import signal
-    import time
-
+@pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_stop_signal_saves_a_checkpoint_and_exits_with_128_plus_its_number(
+    tmp_path, tiny_yaml, signum, status
+):
+    """Ctrl-C and SIGTERM (schedulers, timeout, a shutdown) both checkpoint and stop."""
     run = tmp_path / "run"
     proc = subprocess.Popen(
         [
@@ -189,9 +192,9 @@ def test_ctrl_c_saves_a_checkpoint_and_exits_cleanly(tmp_path, tiny_yaml):
     metrics = run / "metrics.csv"
     while time.time() < deadline and (not metrics.exists() or metrics.read_text().count("\n") < 3):
         time.sleep(0.2)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(signum)
     out, err = proc.communicate(timeout=120)
-    assert proc.returncode == 0, err
+    assert proc.returncode == status, err
     assert "interrupted, checkpoint saved" in out
     state = load_checkpoint(run / "state.pt")
     assert 0 < state["counters"]["step"] < 1_000_000
@@ -206,7 +209,10 @@ def test_installed_console_script_lists_every_command():
     script = Path(sys.executable).parent / "bipedal"
     assert script.exists(), f"no console script beside {sys.executable}: install with pip first"
     proc = subprocess.run(
-        [str(script), "--help"], capture_output=True, text=True, timeout=120,
+        [str(script), "--help"],
+        capture_output=True,
+        text=True,
+        timeout=120,
         env={"COLUMNS": "200", "PATH": str(script.parent)},
     )
     assert proc.returncode == 0, proc.stderr

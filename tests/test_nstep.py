@@ -47,12 +47,22 @@ def test_nstep_target_matches_reference_value_and_gradient(n, T, terminated_at_e
     reward = torch.tensor([tr.reward for tr in transitions], dtype=f64)
     discount = torch.tensor([tr.discount for tr in transitions], dtype=f64)
     terminated = torch.tensor([float(tr.terminated) for tr in transitions], dtype=f64)
-    fast = truncated_target(next_atoms, reward, terminated, next_log_prob, alpha, gamma, k, discount)
+    fast = truncated_target(
+        next_atoms, reward, terminated, next_log_prob, alpha, gamma, k, discount
+    )
     ref = torch.stack(
         [
             ref_nstep_target(
-                next_atoms[t], rewards, n, gamma, T - 1, terminated_at_end, next_log_prob[t],
-                alpha, k, t,
+                next_atoms[t],
+                rewards,
+                n,
+                gamma,
+                T - 1,
+                terminated_at_end,
+                next_log_prob[t],
+                alpha,
+                k,
+                t,
             )
             for t in range(T)
         ]
