@@ -86,12 +86,32 @@ def test_export_gives_the_checkpoints_actions_with_torch_alone(tmp_path, trained
         assert torch.allclose(actions, actor.deterministic(obs), atol=1e-6)
 
 
+def info_rows(text):
+    """``bipedal info``'s table as {row name: value}."""
+    rows = {}
+    for line in text.splitlines():
+        cells = [c.strip() for c in line.strip("│ ").split("│")]
+        if len(cells) == 2 and cells[0]:
+            rows[cells[0]] = cells[1]
+    return rows
+
+
 def test_info_describes_both_kinds_of_checkpoint(trained, capsys):
-    for name in ("policy.pt", "state.pt"):
-        code, out, err = run_cli(["info", trained / name], capsys)
-        assert code == 0, err
-        assert "BipedalWalker-v3" in out and "300" in out and "v1" in out
-    assert "transitions" in out
+    state = load_checkpoint(trained / "state.pt")
+    code, out, err = run_cli(["info", trained / "policy.pt"], capsys)
+    assert code == 0, err
+    rows = info_rows(out)
+    assert rows["kind"] == "policy (bipedal-policy v1)"
+    assert rows["env"] == "BipedalWalker-v3" and rows["obs / action size"] == "24 / 4"
+    assert rows["steps"] == "300" and rows["episodes"] == str(state["counters"]["episodes"])
+    assert rows["seed"] == "3"
+    assert rows["last eval"].startswith("episodes 2, mean ")
+    code, out, err = run_cli(["info", trained / "state.pt"], capsys)
+    assert code == 0, err
+    rows = info_rows(out)
+    assert rows["kind"] == "training state (bipedal-train-state v1)"
+    assert rows["steps"] == "300"
+    assert rows["replay buffer"] == f"{int(state['buffer']['size']):,} transitions"
 
 
 def test_output_errors(tmp_path, trained, capsys):

@@ -12,12 +12,28 @@ def test_default_yaml_equals_the_dataclass_defaults():
     assert resolve_config(CONFIGS / "walker.yaml") == Config()
 
 
-@pytest.mark.parametrize("name", ["walker", "paper", "hardcore", "mlp-ablation", "curriculum"])
-def test_shipped_configs_load(name):
-    path = CONFIGS / f"{name}.yaml"
-    if not path.exists():
-        pytest.skip(f"{path.name} not shipped")
-    resolve_config(path)
+SHIPPED = {
+    # name: (env, d2rl, action_repeat, history, n_step, fall_penalty, reward_scale)
+    "walker": ("BipedalWalker-v3", True, 1, 1, 1, None, 1.0),
+    "paper": ("BipedalWalker-v3", True, 1, 1, 1, None, 1.0),
+    "mlp-ablation": ("BipedalWalker-v3", False, 1, 1, 1, None, 1.0),
+    "curriculum": ("BipedalWalker-v3", True, 1, 1, 1, None, 1.0),
+    "hardcore": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-curriculum": ("BipedalWalker-v3", True, 3, 4, 3, -5.0, 5.0),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SHIPPED))
+def test_shipped_configs_load_with_the_settings_their_comments_describe(name):
+    cfg = resolve_config(CONFIGS / f"{name}.yaml")
+    a, t = cfg.agent, cfg.train
+    got = (cfg.env, a.d2rl, a.action_repeat, a.history, a.n_step, t.fall_penalty, t.reward_scale)
+    assert got == SHIPPED[name]
+    assert config_from_dict(cfg.to_dict()) == cfg  # what a run writes reads back the same
+
+
+def test_every_shipped_config_is_tested():
+    assert {p.stem for p in CONFIGS.glob("*.yaml")} == set(SHIPPED)
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():

@@ -72,13 +72,20 @@ def test_squashed_gaussian_log_prob_matches_numerical_density():
     assert torch.allclose(log_prob[ok], numeric[ok], atol=1e-4)
 
 
-def test_deterministic_action_is_tanh_of_mean_and_bounded():
-    actor = SquashedGaussianActor(24, 4)
+def test_deterministic_action_is_tanh_of_the_gaussian_mean_set_by_hand():
+    """Zero weights: the network outputs its last bias, so mu = b_out[:A] whatever the input,
+    and the deterministic action is tanh(mu), known without running any of our code."""
+    actor = SquashedGaussianActor(24, 4, hidden=8)
+    with torch.no_grad():
+        for p in actor.parameters():
+            p.zero_()
+        actor.net.b_out[0, 0] = torch.tensor([0.5, -2.0, 30.0, 0.0, 1.0, 1.0, 1.0, 1.0])
     obs = torch.randn(10, 24) * 100
-    mean, _ = actor.distribution_params(obs)
-    assert torch.equal(actor.deterministic(obs), torch.tanh(mean))
-    action, log_prob = actor.sample(obs)
+    want = torch.tensor([math.tanh(0.5), math.tanh(-2.0), 1.0, 0.0]).expand(10, 4)
+    assert torch.allclose(actor.deterministic(obs), want, atol=1e-7)
+    action, log_prob = actor.sample(obs)  # sampled actions stay inside [-1, 1]
     assert action.abs().max() <= 1 and torch.isfinite(log_prob).all()
+    assert not torch.allclose(action, want)
 
 
 def test_critics_output_shape_and_detached_params_give_input_gradient_only():
