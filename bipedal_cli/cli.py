@@ -332,24 +332,9 @@ def curriculum(
 
 
 def _report_curriculum(result) -> None:
-    from rich.table import Table
+    from .display import curriculum_table
 
-    table = Table(title=f"curriculum ({result.stopped}): {printable(result.run_dir)}")
-    for col in ("stage", "env", "steps", "episodes", "wall time", "evaluation", "result"):
-        table.add_column(col, justify="right")
-    for i, st in enumerate(result.stages, 1):
-        ev = st["full_eval"] or st["last_eval"]
-        ev_text = f"{ev['mean']:.1f} +- {ev['std']:.1f} ({ev['episodes']} ep.)" if ev else "-"
-        table.add_row(
-            str(i),
-            st["env"],
-            f"{st['steps']:,}",
-            f"{st['episodes']:,}",
-            f"{st['wall_time'] / 60:.1f} min",
-            ev_text,
-            st["stopped"],
-        )
-    console.print(table)
+    console.print(curriculum_table(result, printable(result.run_dir)))
     console.print(f"resume: bipedal resume {printable(result.run_dir)}")
 
 
@@ -406,50 +391,10 @@ def export(
 @app.command()
 def info(ckpt: Annotated[Path, typer.Argument(metavar="CKPT")]) -> None:
     """What a checkpoint holds: env, steps, episodes, config, evaluations, format version."""
-    from rich.table import Table
+    from .checkpoint import load_checkpoint
+    from .display import checkpoint_table
 
-    from .checkpoint import TRAIN_FORMAT, load_checkpoint
-
-    data = load_checkpoint(ckpt)
-    if data["format"] == TRAIN_FORMAT:
-        c = data["counters"]
-        meta = {
-            "steps": c["step"],
-            "episodes": c["episodes"],
-            "wall_time": round(c["wall_time"], 1),
-            "last_eval": data["last_eval"],
-            "full_eval": data["full_eval"],
-            "replay buffer": f"{int(data['buffer']['size']):,} transitions",
-            "curriculum": data.get("curriculum"),
-        }
-    else:
-        meta = {k: v for k, v in data.get("meta", {}).items() if k not in ("env", "seed")}
-    table = Table(title=str(ckpt), show_header=False)
-    table.add_column(style="cyan")
-    table.add_column()
-    kind = "training state" if data["format"] == TRAIN_FORMAT else "policy"
-    table.add_row("kind", f"{kind} ({data['format']} v{data['version']})")
-    table.add_row("env", data["env"])
-    table.add_row("obs / action size", f"{data['obs_dim']} / {data['act_dim']}")
-    agent = data["config"].get("agent", {})
-    table.add_row(
-        "policy",
-        f"last {agent.get('history', 1)} observation(s); each action held for "
-        f"{agent.get('action_repeat', 1)} env step(s)",
-    )
-    for key, value in meta.items():
-        if isinstance(value, dict):
-            value = ", ".join(
-                f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}"
-                for k, v in value.items()
-                if k in ("mean", "std", "episodes", "falls", "step", "stage")
-            ) or str(value)
-        table.add_row(key.replace("_", " "), "-" if value is None else str(value))
-    cfg = data["config"]
-    table.add_row("seed", str(cfg["seed"]))
-    table.add_row("agent", ", ".join(f"{k}={v}" for k, v in cfg["agent"].items()))
-    table.add_row("train", ", ".join(f"{k}={v}" for k, v in cfg["train"].items()))
-    console.print(table)
+    console.print(checkpoint_table(load_checkpoint(ckpt), printable(ckpt)))
 
 
 def main(argv: list[str] | None = None) -> None:
