@@ -98,4 +98,6 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from record import run_recorded
+
+    run_recorded("loop_profile", main)

@@ -1,6 +1,7 @@
 """Steps, episodes and wall time to solve, from run directories' metrics.csv (README's table).
 
     python benchmarks/solve_table.py runs/solve-seed0 runs/solve-seed1 runs/solve-seed2
+    python benchmarks/solve_table.py docs/runs/*/metrics.csv      # the committed copies
 
 A run counts as solved at its first ``full_eval`` row (the 100-episode deterministic test that
 ``--until-solved`` runs) whose mean is above 300. A run without one is reported with the steps it
@@ -20,8 +21,9 @@ from bipedal_cli.metrics import METRICS_FILE, read_metrics  # noqa: E402
 
 
 def summarize_run(run_dir: Path, threshold: float = 300.0) -> dict:
-    rows = read_metrics(run_dir / METRICS_FILE)
-    seed = run_dir.name
+    path = run_dir if run_dir.is_file() else run_dir / METRICS_FILE  # a run dir or its csv
+    rows = read_metrics(path)
+    seed = run_dir.parent.name if run_dir.is_file() else run_dir.name
     full = [r for r in rows if r["kind"] == "full_eval"]
     solved = next((r for r in full if float(r["return"]) > threshold), None)
     last = rows[-1]

@@ -30,15 +30,7 @@ import time
 WARMUP = 1000
 
 
-def cpu_name() -> str:
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
+from record import cpu_name  # noqa: E402
 
 
 def peak_rss_mb() -> float:
