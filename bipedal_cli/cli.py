@@ -45,6 +45,7 @@ def _summary_line(result) -> str:
         "budget": "step budget reached",
         "solved": "solved",
         "interrupted": "interrupted, checkpoint saved",
+        "pruned": "pruned by the sweep",
     }[result.stopped]
     return (
         f"{why}: {result.steps:,} env steps, {result.episodes:,} episodes, "
@@ -395,6 +396,15 @@ def info(ckpt: Annotated[Path, typer.Argument(metavar="CKPT")]) -> None:
     from .display import checkpoint_table
 
     console.print(checkpoint_table(load_checkpoint(ckpt), printable(ckpt)))
+
+
+def _add_sweep() -> None:
+    from .cli_sweep import sweep_app
+
+    app.add_typer(sweep_app, name="sweep")
+
+
+_add_sweep()
 
 
 def main(argv: list[str] | None = None) -> None:

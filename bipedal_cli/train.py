@@ -18,7 +18,7 @@ import os
 import signal
 import time
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -93,7 +93,7 @@ class TrainResult:
     steps: int
     episodes: int
     wall_time: float
-    stopped: str  # "budget" | "solved" | "interrupted"
+    stopped: str  # "budget" | "solved" | "interrupted" | "pruned"
     last_eval: dict | None
     full_eval: dict | None
     signal: int | None = None  # the signal that interrupted it
@@ -134,6 +134,9 @@ class Trainer:
         self._update_metrics: Mapping[str, torch.Tensor] | None = None  # last update's, unsynced
         self.curriculum: dict[str, Any] | None = None  # set by curriculum.py
         self._stop_signal: int | None = None  # set by request_stop
+        # called after each periodic evaluation (and full test); True stops the run as
+        # "pruned" (bipedal sweep's pruner)
+        self.on_evaluation: Callable[[Trainer], bool] | None = None
 
     # ----------------------------------------------------------------- state
     def state_dict(self) -> dict[str, Any]:
@@ -321,8 +324,9 @@ class Trainer:
                         self._update_metrics = self.agent.update(batch)
                 self.wall_time = wall_base + time.perf_counter() - session_start
                 if t.eval_every and self.step % t.eval_every == 0:
-                    if self._evaluate(metrics, until_solved):
-                        stopped = "solved"
+                    outcome = self._evaluate(metrics, until_solved)
+                    if outcome is not None:
+                        stopped = outcome
                         break
                 if t.checkpoint_every and self.step % t.checkpoint_every == 0:
                     self.save()
@@ -418,16 +422,19 @@ class Trainer:
             **self._common(),
         }
 
-    def _evaluate(self, metrics: MetricsWriter, until_solved: bool) -> bool:
+    def _evaluate(self, metrics: MetricsWriter, until_solved: bool) -> str | None:
         """The periodic evaluation; with ``until_solved``, the full test once it passes the
-        threshold. Returns True when the full test says solved."""
+        threshold. Returns "solved" when the full test says so, "pruned" when
+        :attr:`on_evaluation` asks to stop, else None."""
         t = self.cfg.train
         self.reporter.update({**self.snapshot(0.0), "phase": "evaluating"})
         self.last_eval = self.evaluate(t.eval_episodes)
         self.last_eval["step"] = self.step
         metrics.write(self._eval_row("eval", self.last_eval))
         if not until_solved or self.last_eval["mean"] <= t.solved_threshold:
-            return False
+            if self.on_evaluation is not None and self.on_evaluation(self):
+                return "pruned"
+            return None
         self.reporter.log(
             f"step {self.step}: evaluation {self.last_eval['mean']:.1f} > "
             f"{t.solved_threshold:g}; running the {t.solved_episodes}-episode test"
@@ -439,7 +446,11 @@ class Trainer:
             f"{t.solved_episodes}-episode evaluation: "
             f"{self.full_eval['mean']:.1f} +- {self.full_eval['std']:.1f}"
         )
-        return self.full_eval["solved"]
+        if self.full_eval["solved"]:
+            return "solved"
+        if self.on_evaluation is not None and self.on_evaluation(self):
+            return "pruned"
+        return None
 
     def snapshot(self, steps_per_s: float) -> dict[str, Any]:
         recent = list(self.recent_returns)

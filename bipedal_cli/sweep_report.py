@@ -1,0 +1,136 @@
+"""``bipedal sweep show``: a study's trials, its best parameters, its plots, its best config."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .checkpoint import atomic_write_text
+from .errors import UserError
+from .paths import atomic_path
+from .sweep import DEFINITION
+from .sweep_storage import open_storage, redact
+
+
+def load_study(study: str, storage: str | None, study_dir: Path):
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    if storage is None and not (study_dir / "journal.log").exists():
+        raise UserError(f"STUDY {study}: no study in {study_dir}; start one with bipedal sweep")
+    backend = open_storage(storage, study_dir, heartbeat=60)
+    try:
+        loaded = optuna.load_study(study_name=study, storage=backend)
+    except KeyError:
+        where = redact(storage) if storage else str(study_dir)
+        raise UserError(f"STUDY {study}: no such study in {where}") from None
+    if DEFINITION not in loaded.user_attrs:
+        raise UserError(f"STUDY {study}: not a study made by bipedal sweep")
+    return loaded
+
+
+def trial_rows(study) -> list[dict[str, Any]]:
+    """One dict per trial: number, state, value, solved, env steps, best evaluation, params."""
+    rows = []
+    for t in study.get_trials(deepcopy=False):
+        rows.append(
+            {
+                "number": t.number,
+                "state": t.state.name,
+                "value": t.value,
+                "solved": t.user_attrs.get("solved"),
+                "env_steps": t.user_attrs.get("env_steps"),
+                "best_eval": t.user_attrs.get("best_eval"),
+                "params": dict(t.params),
+                "retry_of": t.user_attrs.get("retry_of", t.system_attrs.get("failed_trial")),
+                "worker": t.user_attrs.get("worker"),
+            }
+        )
+    return rows
+
+
+def best_trial(study):
+    from optuna.trial import TrialState
+
+    done = study.get_trials(deepcopy=False, states=(TrialState.COMPLETE,))
+    return min(done, key=lambda t: t.value) if done else None
+
+
+def write_best_config(study, out: Path) -> dict:
+    """The best trial's whole config as YAML that ``bipedal train --config`` takes as is."""
+    best = best_trial(study)
+    if best is None:
+        raise UserError(f"--best-config {out}: the study has no completed trial yet")
+    cfg = dict(best.user_attrs["config"])
+    head = (
+        f"# best trial {best.number} of study {study.study_name} (bipedal sweep): "
+        f"score {best.value:g}\n"
+    )
+    atomic_write_text(out, head + yaml.safe_dump(cfg, sort_keys=False))
+    return cfg
+
+
+def plot_history(study, out: Path) -> Path:
+    """Each trial's score (solved ones: env steps to solve) and the best so far."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from optuna.trial import TrialState
+
+    done = [t for t in study.get_trials(deepcopy=False) if t.state == TrialState.COMPLETE]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    solved = [t for t in done if t.user_attrs.get("solved")]
+    unsolved = [t for t in done if not t.user_attrs.get("solved")]
+    ax.scatter([t.number for t in solved], [t.value for t in solved], label="solved: env steps")
+    ax.scatter(
+        [t.number for t in unsolved],
+        [t.value for t in unsolved],
+        marker="x",
+        label="not solved (budget + 1000 - best eval)",
+    )
+    best, xs, ys = float("inf"), [], []
+    for t in sorted(done, key=lambda t: t.number):
+        best = min(best, t.value)
+        xs.append(t.number)
+        ys.append(best)
+    ax.step(xs, ys, where="post", color="k", label="best so far")
+    ax.set_xlabel("trial")
+    ax.set_ylabel("score (lower is better)")
+    ax.set_title(f"{study.study_name}: optimization history")
+    ax.legend(fontsize=8)
+    return _save(fig, out)
+
+
+def plot_importances(study, out: Path) -> Path | None:
+    """Optuna's parameter importances (PED-ANOVA) as a bar chart; None with too few trials."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import optuna
+
+    try:
+        importances = optuna.importance.get_param_importances(study)
+    except (RuntimeError, ValueError):
+        return None
+    if not importances:
+        return None
+    names = list(importances)[::-1]
+    fig, ax = plt.subplots(figsize=(7, 0.4 * len(names) + 1.5))
+    ax.barh(names, [importances[n] for n in names])
+    ax.set_xlabel("importance")
+    ax.set_title(f"{study.study_name}: parameter importances")
+    return _save(fig, out)
+
+
+def _save(fig, out: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
+    return out
