@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -112,12 +113,14 @@ def plot_importances(study, out: Path) -> Path | None:
     import matplotlib.pyplot as plt
     import optuna
 
-    try:
-        importances = optuna.importance.get_param_importances(study)
-    except (RuntimeError, ValueError):
-        return None
-    if not importances:
-        return None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            importances = optuna.importance.get_param_importances(study)
+        except (RuntimeError, ValueError):
+            return None
+    if not importances or any("too small" in str(w.message) for w in caught):
+        return None  # Optuna would return equal importances: nothing to show
     names = list(importances)[::-1]
     fig, ax = plt.subplots(figsize=(7, 0.4 * len(names) + 1.5))
     ax.barh(names, [importances[n] for n in names])
