@@ -5,6 +5,7 @@ import csv
 import json
 
 import numpy as np
+import pytest
 import torch
 
 from bipedal_cli.checkpoint import actor_from_checkpoint, load_checkpoint
@@ -98,3 +99,27 @@ def test_export_takes_the_observation_history(tmp_path):
     actor, _ = actor_from_checkpoint(load_checkpoint(tmp_path / "run" / "policy.pt"))
     obs = torch.randn(5, 3, 24)
     assert torch.allclose(program(obs), actor.deterministic(obs.reshape(5, 72)), atol=1e-6)
+
+
+def test_the_readme_loop_runs_an_exported_policy_with_gymnasium_alone(tmp_path):
+    """docs/examples/run_exported_policy.py (README's plain Gymnasium loop) scores what
+    bipedal's evaluation scores for the same policy and seed."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from bipedal_cli.export import export_policy
+
+    train(config_from_dict(featured(total_steps=150)), tmp_path / "run")
+    actor, cfg = actor_from_checkpoint(load_checkpoint(tmp_path / "run" / "policy.pt"))
+    export_policy(actor, tmp_path / "p.pt2", cfg.agent.history, cfg.agent.action_repeat)
+    script = Path(__file__).resolve().parent.parent / "docs" / "examples" / "run_exported_policy.py"
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path / "p.pt2"), "BipedalWalker-v3", "4"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    ).stdout
+    (result,) = evaluate_actor(actor, cfg.agent, cfg.env, [4], workers=1)
+    assert float(out.split()[-1]) == pytest.approx(result.ret, abs=0.01)
