@@ -83,7 +83,7 @@ def load_checkpoint(path: str | Path, option: str = "CKPT") -> dict[str, Any]:
         )
     from .schema import check_checkpoint
 
-    check_checkpoint(data, f"{option} {path}")
+    check_checkpoint(data, f"{option} {path}", data["format"] == TRAIN_FORMAT)
     data["path"] = str(path)
     return data
 

@@ -15,7 +15,6 @@ from typing import Any
 
 import torch
 
-from .checkpoint import TRAIN_FORMAT
 from .config import ACT_SIZE, OBS_SIZE, Config, config_from_dict
 from .errors import UserError
 
@@ -66,8 +65,9 @@ def _check_weights(
             raise _fail(where, f"{key}.{name}", "holds NaN or infinite values")
 
 
-def check_checkpoint(data: dict, where: str) -> Config:
-    """Check ``data`` (a loaded checkpoint) and return its config."""
+def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
+    """Check ``data`` (a loaded policy file, or with ``train_state`` a training state) and
+    return its config."""
     raw_cfg = _get(data, "config", Mapping, where)
     cfg = config_from_dict(dict(raw_cfg), f"{where}: config")
     env = _get(data, "env", str, where)
@@ -78,7 +78,7 @@ def check_checkpoint(data: dict, where: str) -> Config:
     if (obs_dim, act_dim) != want:
         raise _fail(where, "obs_dim/act_dim", f"are {obs_dim}/{act_dim}; expected {want}")
     shapes = _shapes(cfg, obs_dim, act_dim)
-    if data["format"] != TRAIN_FORMAT:
+    if not train_state:
         _check_weights(_get(data, "actor", Mapping, where), shapes["actor"], where, "actor")
         _get(data, "meta", Mapping, where)
         return cfg

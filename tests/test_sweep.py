@@ -237,22 +237,12 @@ def test_sweep_bad_input_is_one_line_and_leaves_the_study_intact(
 ):
     config, space = sweep_files
     monkeypatch.chdir(tmp_path)
-    status, _, err = run_cli(
-        [
-            "sweep",
-            "--config",
-            config,
-            "--space",
-            space,
-            "--study",
-            "s",
-            "--trials",
-            1,
-            "--steps-per-trial",
-            100,
-        ],
-        capsys,
-    )
+
+    def sweep(*extra):
+        args = ["sweep", "--config", config, "--study", "s", "--trials", 1]
+        return run_cli([*args, "--steps-per-trial", 100, *extra], capsys)
+
+    status, _, err = sweep("--space", space)
     assert status == 0, err
     log = tmp_path / "sweeps" / "s" / "journal.log"
     before = log.read_bytes()
@@ -270,21 +260,7 @@ def test_sweep_bad_input_is_one_line_and_leaves_the_study_intact(
         (["--space", space, "--storage", "redis://127.0.0.1"], "expected a journal file"),
     ]
     for extra, needle in cases:
-        status, _, err = run_cli(
-            [
-                "sweep",
-                "--config",
-                config,
-                "--study",
-                "s",
-                "--trials",
-                1,
-                "--steps-per-trial",
-                100,
-                *extra,
-            ],
-            capsys,
-        )
+        status, _, err = sweep(*extra)
         lines = err.strip().splitlines()
         assert status == 2 and len(lines) == 1 and needle in lines[0], err
         assert "secret" not in err
