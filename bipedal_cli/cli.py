@@ -15,9 +15,10 @@ from typing import Annotated
 import typer
 from rich.console import Console
 
-from .config import canonical_env_id, check_count, check_seeds, resolve_config
+from .config import canonical_env_id, resolve_config
 from .errors import UserError
 from .paths import check_output_path, printable
+from .validation import check_count, check_seeds
 
 app = typer.Typer(
     add_completion=False,

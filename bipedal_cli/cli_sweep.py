@@ -10,9 +10,10 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from .config import canonical_env_id, check_count, check_seeds, resolve_config
+from .config import canonical_env_id, resolve_config
 from .errors import UserError
 from .paths import check_output_path, printable
+from .validation import check_count, check_seeds
 
 console = Console()
 sweep_app = typer.Typer(

@@ -15,8 +15,9 @@ from typing import Any
 
 import torch
 
-from .config import ACT_SIZE, OBS_SIZE, Config, config_from_dict
+from .config import Config, config_from_dict
 from .errors import UserError
+from .validation import ACT_SIZE, OBS_SIZE
 
 AGENT_NETWORKS = ("actor", "critic", "critic_target")
 OPTIMIZERS = {"actor_opt": "actor", "critic_opt": "critic", "alpha_opt": None}

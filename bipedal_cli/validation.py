@@ -1,0 +1,129 @@
+"""The range of every config value and of the CLI's counts and seeds, checked in one place.
+
+:func:`validate` runs whenever a config is resolved (:func:`bipedal_cli.config.config_from_dict`:
+YAML, ``--set``, and the config inside every checkpoint), so a bad value is one line naming its
+key before anything is built or written.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING
+
+from .errors import UserError
+
+if TYPE_CHECKING:
+    from .config import Config
+
+REPLAY_CHOICES = ("keep", "clear")  # curriculum.replay
+
+SEED_LIMIT = 2**31  # env seeds, numpy and torch seeds: 0 <= seed < 2^31
+OBS_SIZE, ACT_SIZE = 24, 4  # BipedalWalker(-Hardcore)-v3
+
+
+def check_seeds(option: str, first: int, count: int = 1) -> None:
+    """Seeds first .. first + count - 1 must lie in [0, 2^31): one line naming ``option``."""
+    if not (0 <= first and first + count <= SEED_LIMIT):
+        raise UserError(
+            f"{option}: expected a seed in [0, {SEED_LIMIT - count}] (seeds {first} .. "
+            f"{first + count - 1} are used)"
+        )
+
+
+MAX_EPISODES = 100_000  # per evaluation: 10^9 would exhaust memory before the first episode
+
+
+def check_count(option: str, value: int, limit: int = MAX_EPISODES) -> None:
+    if not 1 <= value <= limit:
+        raise UserError(f"{option} {value}: expected an integer in [1, {limit:,}]")
+
+
+MAX_THREADS = 256  # torch.set_num_threads(100000) crashes the process
+
+
+def replay_bytes(cfg: Config) -> int:
+    """Memory of a full replay buffer: obs and next obs (H * 24), action, reward, flags."""
+    per = 2 * cfg.agent.history * OBS_SIZE + ACT_SIZE + 3
+    return cfg.train.buffer_size * per * 4
+
+
+def physical_memory() -> int:
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return 1 << 50
+
+
+def validate(cfg: Config, source: str) -> None:
+    """Every value's range, checked when the config is resolved (also a checkpoint's config)."""
+    a, t, c = cfg.agent, cfg.train, cfg.curriculum
+    evals = max(t.eval_episodes, t.solved_episodes)
+    checks = [
+        (0.0 < a.gamma <= 1.0, "agent.gamma", "a number in (0, 1]"),
+        (a.lr > 0, "agent.lr", "a positive number"),
+        (a.batch_size >= 1, "agent.batch_size", "a positive integer"),
+        (0.0 < a.tau <= 1.0, "agent.tau", "a number in (0, 1]"),
+        (a.n_critics >= 1, "agent.n_critics", "a positive integer"),
+        (a.n_quantiles >= 1, "agent.n_quantiles", "a positive integer"),
+        (
+            0 <= a.drop_per_critic < a.n_quantiles,
+            "agent.drop_per_critic",
+            "an integer in [0, n_quantiles)",
+        ),
+        (a.actor_hidden >= 1, "agent.actor_hidden", "a positive width"),
+        (a.critic_hidden >= 1, "agent.critic_hidden", "a positive width"),
+        (a.n_layers >= 1, "agent.n_layers", "a positive integer"),
+        (a.init_alpha > 0, "agent.init_alpha", "a positive number"),
+        (a.log_std_min < a.log_std_max, "agent.log_std_min", "a number below agent.log_std_max"),
+        (a.actor_hidden <= 65536, "agent.actor_hidden", "at most 65536"),
+        (a.critic_hidden <= 65536, "agent.critic_hidden", "at most 65536"),
+        (a.n_layers <= 64, "agent.n_layers", "at most 64"),
+        (a.n_critics * a.n_quantiles <= 1 << 20, "agent.n_critics", "N * M <= 2^20 atoms"),
+        (a.batch_size <= 1 << 20, "agent.batch_size", "at most 2^20"),
+        (a.action_repeat >= 1, "agent.action_repeat", "a positive integer"),
+        (a.history >= 1, "agent.history", "a positive integer"),
+        (a.n_step >= 1, "agent.n_step", "a positive integer"),
+        (t.reward_scale > 0, "train.reward_scale", "a positive number"),
+        (t.total_steps >= 0, "train.total_steps", "a non-negative integer"),
+        (t.warmup_steps >= 0, "train.warmup_steps", "a non-negative integer"),
+        (t.buffer_size >= 1, "train.buffer_size", "a positive integer"),
+        (t.updates_per_step >= 0, "train.updates_per_step", "a non-negative integer"),
+        (t.eval_every >= 0, "train.eval_every", "a non-negative integer"),
+        (t.eval_episodes >= 1, "train.eval_episodes", "a positive integer"),
+        (t.solved_episodes >= 1, "train.solved_episodes", "a positive integer"),
+        (t.checkpoint_every >= 0, "train.checkpoint_every", "a non-negative integer"),
+        (
+            0 <= t.threads <= MAX_THREADS,
+            "train.threads",
+            f"an integer in [0, {MAX_THREADS}] (0: every core)",
+        ),
+        (0 <= cfg.seed < SEED_LIMIT, "seed", f"an integer in [0, {SEED_LIMIT - 1}]"),
+        (
+            0 <= t.eval_seed <= SEED_LIMIT - evals,
+            "train.eval_seed",
+            f"an integer in [0, {SEED_LIMIT - evals}] (eval_seed + episodes < 2^31)",
+        ),
+        (
+            evals <= MAX_EPISODES,
+            "train.*_episodes",
+            "at most 100000",
+        ),
+        (c.walker_steps >= 0, "curriculum.walker_steps", "a non-negative integer"),
+        (c.hardcore_steps >= 0, "curriculum.hardcore_steps", "a non-negative integer"),
+        (c.replay in REPLAY_CHOICES, "curriculum.replay", "keep or clear"),
+        (
+            cfg.device in ("auto", "cpu", "cuda") or cfg.device.startswith("cuda:"),
+            "device",
+            "auto, cpu or cuda",
+        ),
+    ]
+    for ok, key, expected in checks:
+        if not ok:
+            raise UserError(f"{source}: key {key!r} expects {expected}")
+    need, have = replay_bytes(cfg), physical_memory()
+    if need > have:
+        raise UserError(
+            f"{source}: key 'train.buffer_size' expects a buffer that fits in memory: "
+            f"{t.buffer_size:,} transitions need {need / 2**30:.1f} GiB, this machine has "
+            f"{have / 2**30:.1f} GiB"
+        )
