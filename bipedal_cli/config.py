@@ -18,6 +18,7 @@ from typing import Any
 import yaml
 
 from .errors import UserError
+from .validation import validate
 
 ENV_ALIASES = {
     "walker": "BipedalWalker-v3",
@@ -216,9 +217,7 @@ def config_from_dict(data: dict[str, Any], source: str = "config") -> Config:
     cfg = Config()
     _fill(cfg, data or {}, "", source)
     cfg.env = canonical_env_id(cfg.env, f"{source}: key 'env'")
-    from .validation import validate  # the ranges of every value: one place, one module
-
-    validate(cfg, source)
+    validate(cfg, source)  # the range of every value (validation.py)
     return cfg
 
 

@@ -8,12 +8,9 @@ key before anything is built or written.
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING
+from typing import Any
 
 from .errors import UserError
-
-if TYPE_CHECKING:
-    from .config import Config
 
 REPLAY_CHOICES = ("keep", "clear")  # curriculum.replay
 
@@ -41,7 +38,7 @@ def check_count(option: str, value: int, limit: int = MAX_EPISODES) -> None:
 MAX_THREADS = 256  # torch.set_num_threads(100000) crashes the process
 
 
-def replay_bytes(cfg: Config) -> int:
+def replay_bytes(cfg: Any) -> int:
     """Memory of a full replay buffer: obs and next obs (H * 24), action, reward, flags."""
     per = 2 * cfg.agent.history * OBS_SIZE + ACT_SIZE + 3
     return cfg.train.buffer_size * per * 4
@@ -54,8 +51,9 @@ def physical_memory() -> int:
         return 1 << 50
 
 
-def validate(cfg: Config, source: str) -> None:
-    """Every value's range, checked when the config is resolved (also a checkpoint's config)."""
+def validate(cfg: Any, source: str) -> None:
+    """Every value's range in ``cfg`` (a :class:`~bipedal_cli.config.Config`), checked when the
+    config is resolved (also a checkpoint's config)."""
     a, t, c = cfg.agent, cfg.train, cfg.curriculum
     evals = max(t.eval_episodes, t.solved_episodes)
     checks = [
