@@ -79,6 +79,7 @@ def plot_history(study, out: Path) -> Path:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
     from optuna.trial import TrialState
 
     done = [t for t in study.get_trials(deepcopy=False) if t.state == TrialState.COMPLETE]
@@ -99,6 +100,8 @@ def plot_history(study, out: Path) -> Path:
         ys.append(best)
     ax.step(xs, ys, where="post", color="k", label="best so far")
     ax.set_xlabel("trial")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.ticklabel_format(axis="y", useOffset=False, style="plain")
     ax.set_ylabel("score (lower is better)")
     ax.set_title(f"{study.study_name}: optimization history")
     ax.legend(fontsize=8)
