@@ -40,9 +40,9 @@ def load_run(run_dir: str | Path, label: str | None = None, metric: str = "retur
         # losses and alpha are empty during warm-up: those episodes have nothing to plot
         episodes = [r for r in rows if r["kind"] == "episode" and r[metric] != ""]
         evals = [r for r in rows if r["kind"] in ("eval", "full_eval")]
-        steps = np.array([float(r["step"]) for r in episodes])
+        steps = np.array([_env_steps(r) for r in episodes])
         values = np.array([float(r[metric]) for r in episodes])
-        eval_steps = np.array([float(r["step"]) for r in evals])
+        eval_steps = np.array([_env_steps(r) for r in evals])
         eval_means = np.array([float(r["return"]) for r in evals])
     except (KeyError, ValueError):
         raise UserError(
@@ -53,11 +53,17 @@ def load_run(run_dir: str | Path, label: str | None = None, metric: str = "retur
     stages: list[tuple[str, int]] = []
     for r in episodes:
         if not stages or stages[-1][0] != r["stage"]:
-            stages.append((r["stage"], int(float(r["step"]))))
+            stages.append((r["stage"], int(_env_steps(r))))
     name = label or printable(run_dir.name if run_dir.is_dir() else run_dir.parent.name)
     if metric != "return":
         eval_steps, eval_means = np.zeros(0), np.zeros(0)
     return RunCurve(name, steps, values, eval_steps, eval_means, stages)
+
+
+def _env_steps(row: dict) -> float:
+    """Env steps at the row; files written before the column existed count policy steps,
+    which were env steps then (no action repeat)."""
+    return float(row.get("env_steps") or row["step"])
 
 
 def moving_stats(values: np.ndarray, window: int = 10) -> tuple[np.ndarray, np.ndarray]:
