@@ -166,3 +166,19 @@ def test_run_on_device_resumes_and_its_policy_loads_on_cpu(tmp_path, device):
     assert all(torch.isfinite(p).all() for p in actor.parameters())
     action = actor.deterministic(torch.zeros(3, 24))
     assert action.shape == (3, 4) and bool((action.abs() <= 1).all())
+
+
+def test_resume_on_two_threads_continues_a_one_thread_run_to_the_bit(tmp_path):
+    """`bipedal resume RUN --threads 2`: a run moved to another thread count is the same run."""
+    straight = train(config_from_dict(tiny_dict(total_steps=400, threads=1)), tmp_path / "a")
+    train(config_from_dict(tiny_dict(total_steps=230, threads=1)), tmp_path / "b")
+    moved = resume(tmp_path / "b", total_steps=400, threads=2)
+    torch.set_num_threads(1)
+    assert moved.episodes == straight.episodes
+    sa, sb = (load_checkpoint(p / "state.pt") for p in (tmp_path / "a", tmp_path / "b"))
+    assert sb["config"]["train"]["threads"] == 2
+    ignore = ("path", "config")
+    assert_states_equal(
+        {k: v for k, v in sa.items() if k not in ignore},
+        {k: v for k, v in sb.items() if k not in ignore},
+    )
