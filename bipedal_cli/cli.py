@@ -49,7 +49,8 @@ def _summary_line(result) -> str:
         "pruned": "pruned by the sweep",
     }[result.stopped]
     return (
-        f"{why}: {result.steps:,} env steps, {result.episodes:,} episodes, "
+        f"{why}: {result.steps:,} steps ({result.env_steps or result.steps:,} env steps), "
+        f"{result.episodes:,} episodes, "
         f"{minutes:.1f} min; run directory {printable(result.run_dir)}"
     )
 

@@ -97,6 +97,7 @@ class TrainResult:
     last_eval: dict | None
     full_eval: dict | None
     signal: int | None = None  # the signal that interrupted it
+    env_steps: int | None = None  # env steps (steps counts policy steps)
 
 
 class Trainer:
@@ -297,6 +298,7 @@ class Trainer:
             self.last_eval,
             self.full_eval,
             self._stop_signal if stopped == "interrupted" else None,
+            self.env_steps,
         )
 
     def _loop(self, metrics: MetricsWriter, total: int, until_solved: bool) -> tuple[str, float]:
