@@ -62,14 +62,15 @@ def main() -> None:
         if hasattr(agent, name):  # env.step and sample are not the agent's
             setattr(agent, name, timed(name, getattr(agent, name)))
     trainer.buffer.sample = timed("sample", trainer.buffer.sample)
-    fresh_env = trainer._fresh_env
+    runner = trainer.runner  # owns the env: a new one every episode, so wrap each one's step
+    fresh_env = runner._fresh_env
 
-    def fresh_env_timed():  # a new env every episode: wrap each one's step
+    def fresh_env_timed():
         fresh_env()
-        trainer.env.step = timed("env.step", trainer.env.step)
+        runner.env.step = timed("env.step", runner.env.step)
 
-    trainer._fresh_env = fresh_env_timed
-    trainer.env.step = timed("env.step", trainer.env.step)
+    runner._fresh_env = fresh_env_timed
+    runner.env.step = timed("env.step", runner.env.step)
 
     split = agent._worker is not None  # the trainer started it for 2+ threads
     start = time.perf_counter()

@@ -116,10 +116,6 @@ class EpisodeRunner:
         return {
             "seed": e.seed,
             "actions": torch.from_numpy(np.array(e.actions, np.float32).reshape(-1, act_dim)),
-            "ret": e.ret,
-            "env_ret": e.env_ret,
+            "ret": e.ret,  # rebuilt by replay; kept as older versions read it
             "obs": None if self.obs is None else torch.from_numpy(self.obs.copy()),
         }
-
-    def close(self) -> None:
-        self.env.close()
