@@ -79,6 +79,15 @@ def sweep(
     pruner_startup: Annotated[
         int, typer.Option("--pruner-startup", help="Trials before the median pruner acts.")
     ] = 3,
+    sampler_startup: Annotated[
+        int, typer.Option("--sampler-startup", help="Random trials before TPE takes over.")
+    ] = 5,
+    baseline: Annotated[
+        bool,
+        typer.Option(
+            "--baseline/--no-baseline", help="First trial: the base config itself (if in space)."
+        ),
+    ] = True,
     pruner_warmup: Annotated[
         int | None, typer.Option("--pruner-warmup", help="Steps before a trial can be pruned.")
     ] = None,
@@ -93,6 +102,10 @@ def sweep(
 
     check_count("--trials", trials, 100_000)
     check_count("--steps-per-trial", steps_per_trial, 10**9)
+    check_count("--sampler-startup", sampler_startup, 100_000, low=0)
+    check_count("--pruner-startup", pruner_startup, 100_000, low=0)
+    if pruner_warmup is not None:
+        check_count("--pruner-warmup", pruner_warmup, 10**9, low=0)
     check_seeds("--seed", seed)
     if not 1 <= heartbeat <= 3600:
         raise UserError(f"--heartbeat {heartbeat}: expected seconds in [1, 3600]")
@@ -110,6 +123,8 @@ def sweep(
         heartbeat=heartbeat,
         pruner_startup=pruner_startup,
         pruner_warmup=pruner_warmup,
+        sampler_startup=sampler_startup,
+        baseline=baseline,
         root=sweeps_dir,
     )
     result = run_worker(
@@ -148,6 +163,7 @@ def show(
         best = r["best_eval"]
         table.add_row(
             str(r["number"])
+            + (" (base config)" if r["baseline"] else "")
             + (f" (retry of {r['retry_of']})" if r["retry_of"] is not None else ""),
             r["state"].lower(),
             "-" if r["value"] is None else f"{r['value']:,.0f}",

@@ -27,7 +27,7 @@ from typing import Any
 from .config import Config, config_from_dict
 from .errors import UserError
 from .rundir import lock_run_dir, prepare_new_run_dir
-from .sweep_space import suggest
+from .sweep_space import base_params, suggest
 from .sweep_storage import make_gate, open_storage
 
 SWEEP_ROOT = Path("sweeps")
@@ -46,6 +46,8 @@ class SweepSettings:
     seed: int = 0
     heartbeat: int = 60
     pruner_startup: int = 3
+    sampler_startup: int = 5  # random trials before TPE models the results
+    baseline: bool = True  # the study's first trial is the base config, if inside the space
     pruner_warmup: int | None = None  # env steps; None: a third of a trial
     root: Path = SWEEP_ROOT
 
@@ -101,6 +103,9 @@ def create_or_join(settings: SweepSettings, storage, sampler, pruner):
                 pruner=pruner,
             )
             study.set_user_attr(DEFINITION, want)
+            baseline = base_params(settings.base, settings.space) if settings.baseline else None
+            if baseline is not None:
+                study.enqueue_trial(baseline, user_attrs={"baseline": True})
             return study, True
         except optuna.exceptions.DuplicatedStudyError:  # another machine was first
             pass
@@ -200,7 +205,15 @@ def _fail_dead_local_trials(study) -> None:
         if name != host or not pid.isdigit() or _alive(int(pid)):
             continue
         study.tell(t.number, state=TrialState.FAIL)
-        study.enqueue_trial(t.params, user_attrs={"retry_of": t.number})
+        _retry(study, t)
+
+
+def _retry(study, trial) -> None:
+    """Queue a failed or interrupted trial's parameters again, marked as its retry."""
+    attrs = {"retry_of": trial.number}
+    if trial.user_attrs.get("baseline"):
+        attrs["baseline"] = True
+    study.enqueue_trial(trial.params, user_attrs=attrs)
 
 
 def _alive(pid: int) -> bool:
@@ -228,11 +241,13 @@ def run_worker(
     sampler_seed = settings.seed
     gate.acquire()  # creation and the definition check, one worker at a time
     try:
-        sampler = optuna.samplers.TPESampler(seed=sampler_seed)
+        startup = settings.sampler_startup
+        sampler = optuna.samplers.TPESampler(seed=sampler_seed, n_startup_trials=startup)
         pruner = optuna.pruners.MedianPruner(n_startup_trials=settings.pruner_startup)
         study, created = create_or_join(settings, storage, sampler, pruner)
         if not created:  # two workers with one seed would draw the same first parameters
-            study.sampler = optuna.samplers.TPESampler(seed=(sampler_seed + os.getpid()) % 2**31)
+            seed = (sampler_seed + os.getpid()) % 2**31
+            study.sampler = optuna.samplers.TPESampler(seed=seed, n_startup_trials=startup)
     finally:
         gate.release()
     result = SweepResult(settings.study_dir)
@@ -259,7 +274,7 @@ def run_worker(
         try:
             study.optimize(func, n_trials=1, catch=(TrialFailed,), gc_after_trial=False)
         except SweepInterrupted as exc:
-            study.enqueue_trial(study.trials[ran[-1]].params, user_attrs={"retry_of": ran[-1]})
+            _retry(study, study.trials[ran[-1]])
             result.ran += ran
             result.signal = exc.signum
             return result

@@ -47,6 +47,7 @@ def trial_rows(study) -> list[dict[str, Any]]:
                 "params": dict(t.params),
                 "retry_of": t.user_attrs.get("retry_of", t.system_attrs.get("failed_trial")),
                 "worker": t.user_attrs.get("worker"),
+                "baseline": bool(t.user_attrs.get("baseline")),
             }
         )
     return rows

@@ -141,3 +141,29 @@ def suggest(trial, space: dict[str, dict[str, Any]]) -> dict[str, Any]:
         else:
             params[key] = trial.suggest_float(key, spec["low"], spec["high"], log=spec["log"])
     return params
+
+
+def _within(value: Any, spec: dict[str, Any]) -> bool:
+    if spec["type"] == "categorical":
+        return value in spec["choices"]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    if not spec["low"] <= value <= spec["high"]:
+        return False
+    return spec["type"] != "int" or (value - spec["low"]) % spec.get("step", 1) == 0
+
+
+def base_params(config: Config, space: dict[str, dict[str, Any]]) -> dict[str, Any] | None:
+    """The base config's own value of every searched key, or None if one lies outside the
+    space: the baseline trial that a sweep measures first, so its winner is compared with the
+    config it started from under the same conditions."""
+    data = config.to_dict()
+    params: dict[str, Any] = {}
+    for key, spec in space.items():
+        node: Any = data
+        for part in key.split("."):
+            node = node[part]
+        if not _within(node, spec):
+            return None
+        params[key] = node
+    return params

@@ -30,9 +30,9 @@ def check_seeds(option: str, first: int, count: int = 1) -> None:
 MAX_EPISODES = 100_000  # per evaluation: 10^9 would exhaust memory before the first episode
 
 
-def check_count(option: str, value: int, limit: int = MAX_EPISODES) -> None:
-    if not 1 <= value <= limit:
-        raise UserError(f"{option} {value}: expected an integer in [1, {limit:,}]")
+def check_count(option: str, value: int, limit: int = MAX_EPISODES, low: int = 1) -> None:
+    if not low <= value <= limit:
+        raise UserError(f"{option} {value}: expected an integer in [{low}, {limit:,}]")
 
 
 MAX_THREADS = 256  # torch.set_num_threads(100000) crashes the process

@@ -19,7 +19,7 @@ import yaml
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict
 from bipedal_cli.sweep import DEFINITION, SweepSettings, run_worker
-from bipedal_cli.sweep_space import load_space, validate_space
+from bipedal_cli.sweep_space import base_params, load_space, validate_space
 
 from .conftest import tiny_dict
 from .test_cli import run_cli
@@ -212,6 +212,35 @@ def test_a_trial_trailing_the_median_is_pruned_and_its_run_stops(tmp_path):
     assert state["counters"]["step"] == 100
 
 
+def test_the_first_trial_is_the_base_config_so_the_search_has_a_baseline(tmp_path):
+    base = config_from_dict(tiny_dict(eval_every=100, warmup_steps=50))
+    space = validate_space(SPACE, "test")
+    assert base_params(base, space) == {"agent.lr": base.agent.lr, "agent.tau": base.agent.tau}
+    outside = validate_space(
+        {**SPACE, "agent.gamma": {"type": "float", "low": 0.5, "high": 0.9}}, "t"
+    )
+    assert base_params(base, outside) is None  # gamma 0.98 lies outside: no baseline trial
+    steps = validate_space(
+        {"agent.n_quantiles": {"type": "int", "low": 10, "high": 40, "step": 4}}, "t"
+    )
+    assert base_params(config_from_dict({"agent": {"n_quantiles": 25}}), steps) is None  # off-step
+    for study, baseline in (("with", True), ("without", False)):
+        settings = SweepSettings(
+            study=study,
+            base=base,
+            space=space,
+            trials=2,
+            steps_per_trial=100,
+            baseline=baseline,
+            root=tmp_path / "sweeps",
+        )
+        assert run_worker(settings, lambda n: None).ran == [0, 1]
+        first, second = trials_of(study, journal(tmp_path, study))
+        assert (first.params == base_params(base, space)) is baseline
+        assert first.user_attrs.get("baseline", False) is baseline
+        assert "baseline" not in second.user_attrs and second.params != first.params
+
+
 # -------------------------------------------------------------------------- bad input
 
 
@@ -258,6 +287,9 @@ def test_sweep_bad_input_is_one_line_and_leaves_the_study_intact(
             "cannot open",
         ),
         (["--space", space, "--storage", "redis://127.0.0.1"], "expected a journal file"),
+        (["--space", space, "--pruner-startup", "-1"], "--pruner-startup -1"),
+        (["--space", space, "--pruner-warmup", "-5"], "--pruner-warmup -5"),
+        (["--space", space, "--sampler-startup", "-1"], "--sampler-startup -1"),
     ]
     for extra, needle in cases:
         status, _, err = sweep(*extra)
