@@ -18,7 +18,8 @@ import time
 from collections import defaultdict
 
 from bipedal_cli.config import config_from_dict
-from bipedal_cli.train import NullReporter, Trainer
+from bipedal_cli.reporting import NullReporter
+from bipedal_cli.train import Trainer
 
 MAIN = ("sync", "_actor_gradients", "_actor_step", "act", "env.step", "sample", "batch_to_tensors")
 WORKER = ("_critic_gradients", "_critic_step")

@@ -43,7 +43,8 @@ def measure_ours(threads: int, steps: int, device: str, eval_episodes: int, spli
 
     from bipedal_cli.config import config_from_dict
     from bipedal_cli.evaluation import evaluate_actor
-    from bipedal_cli.train import NullReporter, Trainer
+    from bipedal_cli.reporting import NullReporter
+    from bipedal_cli.train import Trainer
 
     cfg = config_from_dict(
         {

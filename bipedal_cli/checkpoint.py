@@ -24,6 +24,7 @@ TRAIN_FORMAT = "bipedal-train-state"
 POLICY_FORMAT = "bipedal-policy"
 STATE_FILE = "state.pt"
 POLICY_FILE = "policy.pt"
+BEST_POLICY_FILE = "best_policy.pt"  # the policy at the best periodic evaluation of its env
 
 
 def atomic_save(obj: Any, path: str | Path) -> None:
@@ -86,6 +87,20 @@ def load_checkpoint(path: str | Path, option: str = "CKPT") -> dict[str, Any]:
     check_checkpoint(data, f"{option} {path}", data["format"] == TRAIN_FORMAT)
     data["path"] = str(path)
     return data
+
+
+def recorded_evaluation(path: Path, env_id: str) -> float | None:
+    """The periodic-evaluation mean that the policy file at ``path`` records, or None when there
+    is no such file, it cannot be read, or it is a policy of another env (a curriculum's
+    earlier stage): the score a new best policy must beat."""
+    if not path.is_file():
+        return None
+    try:
+        meta = load_checkpoint(path)["meta"]
+        last = meta["last_eval"] if meta["env"] == env_id else None
+        return float(last["mean"]) if last else None
+    except (UserError, KeyError, TypeError, ValueError):
+        return None
 
 
 def policy_payload(

@@ -135,9 +135,9 @@ def resume(
     ] = None,
 ) -> None:
     """Continue a run exactly where its last checkpoint left it."""
+    from .devices import resolve_device
     from .display import TrainingDisplay
     from .resume import resume as resume_run
-    from .train import resolve_device
 
     if steps is not None and steps < 0:
         raise UserError(f"--steps {steps}: expected the new total, a non-negative integer")

@@ -14,8 +14,9 @@ from pathlib import Path
 from typing import Any
 
 from .config import ENV_ALIASES, Config
+from .reporting import Reporter
 from .rundir import default_run_dir, lock_run_dir, prepare_new_run_dir
-from .train import Reporter, Trainer, TrainResult
+from .train import Trainer, TrainResult
 
 STAGES = (ENV_ALIASES["walker"], ENV_ALIASES["hardcore"])
 

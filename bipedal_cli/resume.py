@@ -13,8 +13,9 @@ from .config import config_from_dict
 from .curriculum import continue_curriculum
 from .errors import UserError
 from .metrics import METRICS_FILE, MetricsWriter
+from .reporting import Reporter
 from .rundir import lock_run_dir
-from .train import Reporter, Trainer
+from .train import Trainer
 
 
 def state_path_of(path: str | Path) -> Path:

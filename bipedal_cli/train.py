@@ -14,14 +14,13 @@ each is k env steps (fewer at an episode's end); ``env_steps`` counts those.
 
 from __future__ import annotations
 
-import os
 import signal
 import time
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 import torch
@@ -29,19 +28,23 @@ import torch
 from .agent import TQCAgent
 from .buffer import ReplayBuffer
 from .checkpoint import (
+    BEST_POLICY_FILE,
     FORMAT_VERSION,
     POLICY_FILE,
     STATE_FILE,
     TRAIN_FORMAT,
     atomic_save,
     policy_payload,
+    recorded_evaluation,
 )
 from .config import Config
+from .devices import configure_threads, resolve_device
 from .envs import policy_dims
 from .episodes import EpisodeRunner, FinishedEpisode
 from .errors import UserError
 from .evaluation import actor_policy, evaluate_actor, run_episodes, summarize
 from .metrics import METRICS_FILE, MetricsWriter
+from .reporting import NullReporter, Reporter
 from .rundir import (
     default_run_dir,
     lock_run_dir,
@@ -51,40 +54,6 @@ from .rundir import (
     write_plot,
 )
 from .signals import stop_on_signals
-
-
-class Reporter(Protocol):
-    """What the loop tells the outside world; the CLI implements it with rich."""
-
-    def start(self, start_step: int, total_steps: int) -> None: ...
-    def update(self, snapshot: dict[str, Any]) -> None: ...
-    def log(self, text: str) -> None: ...
-    def close(self) -> None: ...
-
-
-class NullReporter:
-    def start(self, start_step: int, total_steps: int) -> None:
-        pass
-
-    def update(self, snapshot: dict[str, Any]) -> None:
-        pass
-
-    def log(self, text: str) -> None:
-        pass
-
-    def close(self) -> None:
-        pass
-
-
-def resolve_device(name: str) -> torch.device:
-    if name == "auto":
-        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
-    if name.startswith("cuda") and not torch.cuda.is_available():
-        raise UserError(f"--device {name}: CUDA is not available on this machine; use cpu or auto")
-    try:
-        return torch.device(name)
-    except RuntimeError:
-        raise UserError(f"--device {name}: expected auto, cpu or cuda") from None
 
 
 @dataclass
@@ -108,11 +77,7 @@ class Trainer:
         self.run_dir = Path(run_dir)
         self.reporter = reporter or NullReporter()
         self.device = resolve_device(cfg.device)
-        threads = cfg.train.threads or os.cpu_count() or 1
-        split = cfg.train.split_update and self.device.type == "cpu" and threads >= 2
-        torch.set_num_threads(threads // 2 if split else threads)  # per part when split
-        # process-wide; see TrainConfig.flush_denormal (measured: benchmarks/throughput.py)
-        torch.set_flush_denormal(cfg.train.flush_denormal)
+        split = configure_threads(cfg.train, self.device)
         torch.manual_seed(cfg.seed)
         self.obs_dim, self.act_dim = policy_dims(cfg.env, cfg.agent)
         self.agent = TQCAgent(cfg.agent, self.obs_dim, self.act_dim, self.device)
@@ -433,6 +398,9 @@ class Trainer:
         self.last_eval = self.evaluate(t.eval_episodes)
         self.last_eval["step"] = self.step
         metrics.write(self._eval_row("eval", self.last_eval))
+        best = recorded_evaluation(self.run_dir / BEST_POLICY_FILE, self.cfg.env)
+        if best is None or self.last_eval["mean"] > best:
+            self.save_policy(self.run_dir / BEST_POLICY_FILE)
         if not until_solved or self.last_eval["mean"] <= t.solved_threshold:
             if self.on_evaluation is not None and self.on_evaluation(self):
                 return "pruned"

@@ -163,8 +163,8 @@ def test_curriculum_runs_walker_then_hardcore_with_one_agent(tmp_path, capsys):
 def test_curriculum_resume_continues_in_the_current_stage(tmp_path):
     from bipedal_cli.config import config_from_dict
     from bipedal_cli.curriculum import continue_curriculum, new_curriculum_trainer, start_curriculum
+    from bipedal_cli.reporting import NullReporter
     from bipedal_cli.resume import resume
-    from bipedal_cli.train import NullReporter
 
     from .test_train import assert_states_equal
 

@@ -145,3 +145,31 @@ def test_restored_optimizers_hold_the_saved_moments(tmp_path):
         for index, moments in saved.items():
             for key in ("step", "exp_avg", "exp_avg_sq"):
                 assert torch.equal(restored[index][key], moments[key]), (name, index, key)
+
+
+def test_best_policy_is_the_actor_at_the_best_evaluation_of_its_env(tmp_path, monkeypatch):
+    """best_policy.pt holds the actor as it was at the highest periodic evaluation so far; a
+    policy file of another env (a curriculum's earlier stage) or an unreadable one is replaced."""
+    from bipedal_cli.checkpoint import BEST_POLICY_FILE, recorded_evaluation
+
+    means = iter([10.0, 50.0, 30.0, 50.0])  # the tie at the end keeps the earlier actor
+    seen = {}
+
+    def fake_evaluate(self, episodes):
+        mean = next(means)
+        seen[self.step] = {k: v.clone() for k, v in self.agent.actor.state_dict().items()}
+        return {"mean": mean, "std": 0.0, "mean_length": 1.0, "falls": 0}
+
+    monkeypatch.setattr(Trainer, "evaluate", fake_evaluate)
+    cfg = config_from_dict(tiny_dict(eval_every=100, warmup_steps=50, total_steps=400))
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / BEST_POLICY_FILE).write_bytes(b"not a checkpoint")
+    train(cfg, run)
+    best = load_checkpoint(run / BEST_POLICY_FILE)
+    assert best["meta"]["last_eval"]["mean"] == 50.0 and best["meta"]["steps"] == 200
+    for key, value in seen[200].items():
+        assert torch.equal(best["actor"][key], value), key
+    assert any(not torch.equal(best["actor"][k], v) for k, v in seen[400].items())  # it learned
+    assert recorded_evaluation(run / BEST_POLICY_FILE, cfg.env) == 50.0
+    assert recorded_evaluation(run / BEST_POLICY_FILE, "BipedalWalkerHardcore-v3") is None
