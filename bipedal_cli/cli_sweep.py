@@ -7,15 +7,14 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
+from .cli_common import console
 from .config import canonical_env_id, resolve_config
 from .errors import UserError
 from .paths import check_output_path, printable
 from .validation import check_count, check_seeds
 
-console = Console()
 sweep_app = typer.Typer(
     help="Optuna TPE search over the config (the paper's sweep); `sweep show` reports a study."
 )
