@@ -1,5 +1,6 @@
 """Split a `bipedal eval --json` report by falls: what the episodes that fell and those that did
-not scored, and how many passed 300 (README's and docs/hardcore.md's Hardcore breakdown).
+not scored, how many passed 300, and where the falls happened (stump, stairs, pit or flat
+ground, when the report has it) (README's and docs/hardcore.md's Hardcore breakdown).
 
     python benchmarks/eval_breakdown.py docs/runs/hardcore-direct-seed0/eval-100.json
 """
@@ -8,6 +9,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections import Counter
 from statistics import mean
 
 
@@ -26,6 +28,10 @@ def main() -> None:
                     f"  {label}: {len(part)} episodes, mean {mean(part):.1f} "
                     f"({min(part):.1f} to {max(part):.1f})"
                 )
+        sites = Counter(e.get("fell_at") for e in episodes if e["fell"])
+        if None not in sites and sites:
+            where = ", ".join(f"{kind} {n}" for kind, n in sites.most_common())
+            print(f"  falls at: {where}")
 
 
 if __name__ == "__main__":

@@ -118,9 +118,16 @@ def eval_table(summary: dict, title: str) -> Table:
         f"{summary['max']:.1f}",
         f"{summary['median']:.1f}",
         f"{summary['mean_length']:.0f}",
-        str(summary["falls"]),
+        falls_text(summary),
     )
     return table
+
+
+def falls_text(summary: dict) -> str:
+    """'12 (stairs 6, pit 4, stump 2)': the falls and where they happened, when known."""
+    where = summary.get("falls_at") or {}
+    parts = ", ".join(f"{kind} {n}" for kind, n in sorted(where.items(), key=lambda kv: -kv[1]))
+    return f"{summary['falls']} ({parts})" if parts else str(summary["falls"])
 
 
 def verdict(summary: dict) -> str:

@@ -18,6 +18,7 @@ import torch
 
 from .config import AgentConfig
 from .envs import make_policy_env
+from .terrain import KINDS, course_obstacles, fall_site
 
 
 @dataclass
@@ -26,6 +27,7 @@ class EpisodeResult:
     ret: float
     length: int
     fell: bool
+    fell_at: str | None = None  # stump | stairs | pit | flat (terrain.py) when it fell
 
 
 def run_episodes(
@@ -39,7 +41,8 @@ def run_episodes(
     The env is the policy's (``agent_cfg``'s action repeat and observation history; none when
     None) with the env's own reward and time limit. Each episode gets a new env: a reused Box2D
     world carries history across resets, and the result of a seed should not depend on which
-    episodes ran before it. Lengths are in env steps.
+    episodes ran before it. Lengths are in env steps. A fall is put down to the obstacle
+    nearest the hull (:func:`bipedal_cli.terrain.fall_site`).
     """
     agent_cfg = agent_cfg or AgentConfig()
     envs = [make_policy_env(env_id, agent_cfg) for _ in seeds]
@@ -47,6 +50,7 @@ def run_episodes(
     returns = np.zeros(len(seeds))
     lengths = np.zeros(len(seeds), dtype=int)
     fell = np.zeros(len(seeds), dtype=bool)
+    fell_at: list[str | None] = [None] * len(seeds)
     active = np.ones(len(seeds), dtype=bool)
     while active.any():
         idx = np.flatnonzero(active)
@@ -59,11 +63,14 @@ def run_episodes(
             if term or trunc:
                 active[i] = False
                 fell[i] = info["fell"]
+                if fell[i]:
+                    course = envs[i].unwrapped
+                    fell_at[i] = fall_site(course_obstacles(course), course.hull.position.x)
     for env in envs:
         env.close()
     return [
-        EpisodeResult(int(s), float(r), int(n), bool(f))
-        for s, r, n, f in zip(seeds, returns, lengths, fell, strict=True)
+        EpisodeResult(int(s), float(r), int(n), bool(f), at)
+        for s, r, n, f, at in zip(seeds, returns, lengths, fell, fell_at, strict=True)
     ]
 
 
@@ -156,6 +163,7 @@ def summarize(results: list[EpisodeResult], threshold: float = 300.0) -> dict:
         "median": float(np.median(returns)),
         "mean_length": float(lengths.mean()),
         "falls": int(sum(r.fell for r in results)),
+        "falls_at": {k: n for k in KINDS if (n := sum(r.fell_at == k for r in results))},
         "threshold": threshold,
         "solved": bool(returns.mean() > threshold),
     }
