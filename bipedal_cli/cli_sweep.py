@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich import box
 from rich.table import Table
 
 from .cli_common import console
@@ -50,10 +51,21 @@ def _study_table(study) -> Table:
     return table
 
 
+def _value(v) -> str:
+    return f"{v:.3g}" if isinstance(v, float) else str(v)
+
+
+HEADERS = {"batch_size": "batch", "warmup_steps": "warmup", "n_critics": "critics"}
+HEADERS["n_quantiles"] = "atoms"
+
+
+def _short(key: str) -> str:
+    """agent.n_quantiles -> n_quantiles: a parameter's name in a line."""
+    return key.rsplit(".", 1)[-1]
+
+
 def _params(params: dict) -> str:
-    return ", ".join(
-        f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in params.items()
-    )
+    return " ".join(f"{_short(k)}={_value(v)}" for k, v in params.items())
 
 
 @sweep_app.callback(invoke_without_command=True)
@@ -155,23 +167,36 @@ def show(
     if best_config is not None:
         check_output_path(best_config, "--best-config", (".yaml", ".yml"), force)
     loaded = load_study(study, storage, sweeps_dir / study)
-    table = Table(title=f"study {study}: trials")
-    for col in ("trial", "state", "score", "solved", "env steps", "best eval", "parameters"):
-        table.add_column(col, justify="right" if col != "parameters" else "left")
-    for r in trial_rows(loaded):
+    rows = trial_rows(loaded)
+    hosts = {str(r["worker"]).rpartition(":")[0] for r in rows if r["worker"]}
+    table = Table(title=f"study {study}: trials", box=box.SIMPLE_HEAD)
+    for col in ("trial", "state", "score", "solved", "env steps", "best eval", "worker pid"):
+        table.add_column(col, justify="right")
+    keys = list(dict.fromkeys(k for r in rows for k in r["params"]))
+    params = Table(
+        title="their parameters (base: the base config's own values)", box=box.SIMPLE_HEAD
+    )
+    for col in ("trial", *(HEADERS.get(_short(k), _short(k)) for k in keys)):
+        params.add_column(col, justify="right")
+    for r in rows:
         best = r["best_eval"]
-        table.add_row(
+        number = (
             str(r["number"])
-            + (" (base config)" if r["baseline"] else "")
-            + (f" (retry of {r['retry_of']})" if r["retry_of"] is not None else ""),
+            + (" base" if r["baseline"] else "")
+            + (f" (retry of {r['retry_of']})" if r["retry_of"] is not None else "")
+        )
+        table.add_row(
+            number,
             r["state"].lower(),
             "-" if r["value"] is None else f"{r['value']:,.0f}",
             {True: "yes", False: "no"}.get(r["solved"], "-"),
             "-" if r["env_steps"] is None else f"{r['env_steps']:,}",
             "-" if best is None else f"{best:.1f}",
-            _params(r["params"]),
+            str(r["worker"] or "-").rpartition(":")[2] if len(hosts) < 2 else str(r["worker"]),
         )
+        params.add_row(number, *(_value(r["params"].get(k, "-")) for k in keys))
     console.print(table)
+    console.print(params)
     console.print(_study_table(loaded))
     folder = sweeps_dir / study
     folder.mkdir(parents=True, exist_ok=True)
