@@ -169,8 +169,13 @@ def show(
     loaded = load_study(study, storage, sweeps_dir / study)
     rows = trial_rows(loaded)
     hosts = {str(r["worker"]).rpartition(":")[0] for r in rows if r["worker"]}
-    table = Table(title=f"study {study}: trials", box=box.SIMPLE_HEAD)
-    for col in ("trial", "state", "score", "solved", "env steps", "best eval", "worker pid"):
+    table = Table(
+        title=f"study {study}: trials (score: env steps to solve; best eval: of the periodic "
+        "evaluations; test: the 100-episode test)",
+        box=box.SIMPLE_HEAD,
+    )
+    columns = ("trial", "state", "score", "solved", "env steps", "best eval", "test", "worker pid")
+    for col in columns:
         table.add_column(col, justify="right")
     keys = list(dict.fromkeys(k for r in rows for k in r["params"]))
     params = Table(
@@ -188,10 +193,11 @@ def show(
         table.add_row(
             number,
             r["state"].lower(),
-            "-" if r["value"] is None else f"{r['value']:,.0f}",
+            "-" if r["value"] is None or r["state"] != "COMPLETE" else f"{r['value']:,.0f}",
             {True: "yes", False: "no"}.get(r["solved"], "-"),
             "-" if r["env_steps"] is None else f"{r['env_steps']:,}",
             "-" if best is None else f"{best:.1f}",
+            "-" if r["test"] is None else f"{r['test']:.1f}",
             str(r["worker"] or "-").rpartition(":")[2] if len(hosts) < 2 else str(r["worker"]),
         )
         params.add_row(number, *(_value(r["params"].get(k, "-")) for k in keys))

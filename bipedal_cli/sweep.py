@@ -172,6 +172,8 @@ def objective(trial, settings: SweepSettings, make_reporter: Callable[[int], Any
             raise
     trial.set_user_attr("env_steps", trainer.env_steps)
     trial.set_user_attr("best_eval", max(evals) if evals else None)
+    if trainer.full_eval is not None:
+        trial.set_user_attr("test", float(trainer.full_eval["mean"]))
     if result.stopped == "interrupted":
         raise SweepInterrupted(result.signal or 2)
     if result.stopped == "pruned":

@@ -44,6 +44,7 @@ def trial_rows(study) -> list[dict[str, Any]]:
                 "solved": t.user_attrs.get("solved"),
                 "env_steps": t.user_attrs.get("env_steps"),
                 "best_eval": t.user_attrs.get("best_eval"),
+                "test": t.user_attrs.get("test"),  # the 100-episode test's mean, if one ran
                 "params": dict(t.params),
                 "retry_of": t.user_attrs.get("retry_of", t.system_attrs.get("failed_trial")),
                 "worker": t.user_attrs.get("worker"),

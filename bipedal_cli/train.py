@@ -391,8 +391,8 @@ class Trainer:
 
     def _evaluate(self, metrics: MetricsWriter, until_solved: bool) -> str | None:
         """The periodic evaluation; with ``until_solved``, the full test once it passes the
-        threshold. Returns "solved" when the full test says so, "pruned" when
-        :attr:`on_evaluation` asks to stop, else None."""
+        threshold. Then :attr:`on_evaluation`, after every evaluation. Returns "solved" when
+        the full test says so, else "pruned" when :attr:`on_evaluation` asks to stop, else None."""
         t = self.cfg.train
         self.reporter.update({**self.snapshot(0.0), "phase": "evaluating"})
         self.last_eval = self.evaluate(t.eval_episodes)
@@ -401,10 +401,17 @@ class Trainer:
         best = recorded_evaluation(self.run_dir / BEST_POLICY_FILE, self.cfg.env)
         if best is None or self.last_eval["mean"] > best:
             self.save_policy(self.run_dir / BEST_POLICY_FILE)
-        if not until_solved or self.last_eval["mean"] <= t.solved_threshold:
-            if self.on_evaluation is not None and self.on_evaluation(self):
-                return "pruned"
-            return None
+        solved = False
+        if until_solved and self.last_eval["mean"] > t.solved_threshold:
+            solved = self._full_test(metrics)
+        stop = self.on_evaluation is not None and self.on_evaluation(self)
+        if solved:
+            return "solved"
+        return "pruned" if stop else None
+
+    def _full_test(self, metrics: MetricsWriter) -> bool:
+        """The ``solved_episodes`` test (100 episodes): True when it passes."""
+        t = self.cfg.train
         self.reporter.log(
             f"step {self.step}: evaluation {self.last_eval['mean']:.1f} > "
             f"{t.solved_threshold:g}; running the {t.solved_episodes}-episode test"
@@ -416,11 +423,7 @@ class Trainer:
             f"{t.solved_episodes}-episode evaluation: "
             f"{self.full_eval['mean']:.1f} +- {self.full_eval['std']:.1f}"
         )
-        if self.full_eval["solved"]:
-            return "solved"
-        if self.on_evaluation is not None and self.on_evaluation(self):
-            return "pruned"
-        return None
+        return bool(self.full_eval["solved"])
 
     def snapshot(self, steps_per_s: float) -> dict[str, Any]:
         recent = list(self.recent_returns)

@@ -1,6 +1,7 @@
 """bipedal sweep: workers sharing a journal file or a real PostgreSQL server, a killed worker's
 trial retried, pruning, and bad input. Trials are tiny (a few hundred steps)."""
 
+import csv
 import glob
 import os
 import shutil
@@ -239,6 +240,27 @@ def test_the_first_trial_is_the_base_config_so_the_search_has_a_baseline(tmp_pat
         assert (first.params == base_params(base, space)) is baseline
         assert first.user_attrs.get("baseline", False) is baseline
         assert "baseline" not in second.user_attrs and second.params != first.params
+
+
+def test_a_solved_trial_records_the_evaluation_and_the_test_that_solved_it(tmp_path):
+    data = tiny_dict(eval_every=100, warmup_steps=50, solved_threshold=-1e6, solved_episodes=2)
+    settings = SweepSettings(
+        study="solve",
+        base=config_from_dict(data),
+        space=validate_space(SPACE, "test"),
+        trials=1,
+        steps_per_trial=300,
+        root=tmp_path / "sweeps",
+    )
+    assert run_worker(settings, lambda n: None).ran == [0]
+    (trial,) = trials_of("solve", journal(tmp_path, "solve"))
+    rows = list(csv.DictReader(open(tmp_path / "sweeps" / "solve" / "trial-0000" / "metrics.csv")))
+    (periodic,) = [r for r in rows if r["kind"] == "eval"]  # solved at the first evaluation
+    (test,) = [r for r in rows if r["kind"] == "full_eval"]
+    assert trial.value == trial.user_attrs["env_steps"] == int(periodic["env_steps"]) == 100
+    assert trial.user_attrs["best_eval"] == pytest.approx(float(periodic["return"]))
+    assert trial.user_attrs["test"] == pytest.approx(float(test["return"]))
+    assert trial.intermediate_values == {100: pytest.approx(-float(periodic["return"]))}
 
 
 # -------------------------------------------------------------------------- bad input
