@@ -3,9 +3,11 @@
 Objective (minimised): the env steps at which a trial passed the 100-episode test that
 ``--until-solved`` runs. A trial that does not solve within ``--steps-per-trial`` scores
 ``budget + 1000 - best evaluation``: below every solved trial, ordered by its best periodic
-evaluation. Each periodic evaluation is reported to a median pruner (as rl-zoo does) as its
-negated mean return, so that lower is better there too; a trial whose training diverges (NaN) is
-pruned and the study goes on.
+evaluation. After each periodic evaluation the trial's best evaluation so far goes to a median
+pruner (rl-zoo reports the latest one), negated so that lower is better there too: a trial is
+stopped when the best it has reached trails what the median trial had reached by the same step,
+and one low 5-episode evaluation after good ones does not stop it. A trial whose training
+diverges (NaN) is pruned and the study goes on.
 
 Workers: every worker runs the same command. The first creates the study and stores its
 definition (search space, base config, steps per trial, budget); the others join it and must
@@ -157,7 +159,7 @@ def objective(trial, settings: SweepSettings, make_reporter: Callable[[int], Any
     def report(trainer: Trainer) -> bool:
         mean = float(trainer.last_eval["mean"])
         evals.append(mean)
-        trial.report(-mean, trainer.step)
+        trial.report(-max(evals), trainer.step)  # the best so far: one noisy dip never prunes
         return trainer.step >= warmup and trial.should_prune()
 
     with lock_run_dir(run_dir):

@@ -263,6 +263,24 @@ def test_a_solved_trial_records_the_evaluation_and_the_test_that_solved_it(tmp_p
     assert trial.intermediate_values == {100: pytest.approx(-float(periodic["return"]))}
 
 
+def test_the_pruner_sees_each_trials_best_evaluation_so_far(tmp_path):
+    settings = SweepSettings(
+        study="best",
+        base=config_from_dict(tiny_dict(eval_every=100, warmup_steps=50)),
+        space=validate_space(SPACE, "test"),
+        trials=1,
+        steps_per_trial=400,
+        root=tmp_path / "sweeps",
+    )
+    run_worker(settings, lambda n: None)
+    (trial,) = trials_of("best", journal(tmp_path, "best"))
+    rows = list(csv.DictReader(open(tmp_path / "sweeps" / "best" / "trial-0000" / "metrics.csv")))
+    evals = [float(r["return"]) for r in rows if r["kind"] == "eval"]
+    best_so_far = [-max(evals[: i + 1]) for i in range(len(evals))]
+    assert len(evals) == 4 and len(set(evals)) > 1
+    assert list(trial.intermediate_values.values()) == pytest.approx(best_so_far, abs=1e-3)
+
+
 # -------------------------------------------------------------------------- bad input
 
 
