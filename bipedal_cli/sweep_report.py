@@ -76,7 +76,9 @@ def write_best_config(study, out: Path) -> dict:
 
 
 def plot_history(study, out: Path) -> Path:
-    """Each trial's score (solved ones: env steps to solve) and the best so far."""
+    """Left: each finished trial's score (solved ones: env steps to solve) and the best so far.
+    Right: what every trial reported to the pruner (its best evaluation so far) against its
+    steps, ending in a dot where it solved and a cross where it was pruned."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -84,29 +86,50 @@ def plot_history(study, out: Path) -> Path:
     from matplotlib.ticker import MaxNLocator
     from optuna.trial import TrialState
 
-    done = [t for t in study.get_trials(deepcopy=False) if t.state == TrialState.COMPLETE]
-    fig, ax = plt.subplots(figsize=(7, 4))
+    trials = study.get_trials(deepcopy=False)
+    done = [t for t in trials if t.state == TrialState.COMPLETE]
+    fig, (ax, curves) = plt.subplots(1, 2, figsize=(12, 4.2))
     solved = [t for t in done if t.user_attrs.get("solved")]
     unsolved = [t for t in done if not t.user_attrs.get("solved")]
     ax.scatter([t.number for t in solved], [t.value for t in solved], label="solved: env steps")
-    ax.scatter(
-        [t.number for t in unsolved],
-        [t.value for t in unsolved],
-        marker="x",
-        label="not solved (budget + 1000 - best eval)",
-    )
+    if unsolved:
+        ax.scatter(
+            [t.number for t in unsolved],
+            [t.value for t in unsolved],
+            marker="x",
+            label="not solved (budget + 1000 - best eval)",
+        )
     best, xs, ys = float("inf"), [], []
     for t in sorted(done, key=lambda t: t.number):
         best = min(best, t.value)
         xs.append(t.number)
         ys.append(best)
     ax.step(xs, ys, where="post", color="k", label="best so far")
+    pruned = [t.number for t in trials if t.state == TrialState.PRUNED]
+    if pruned:
+        ax.plot(
+            pruned, [0] * len(pruned), "|", color="0.5", ms=12, transform=ax.get_xaxis_transform()
+        )
+        ax.plot([], [], "|", color="0.5", label=f"pruned ({len(pruned)})")
     ax.set_xlabel("trial")
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.ticklabel_format(axis="y", useOffset=False, style="plain")
     ax.set_ylabel("score (lower is better)")
     ax.set_title(f"{study.study_name}: optimization history")
     ax.legend(fontsize=8)
+    for t in trials:
+        steps = sorted(t.intermediate_values)
+        if not steps:
+            continue
+        returns = [-t.intermediate_values[s] for s in steps]
+        (line,) = curves.plot(steps, returns, lw=1, label=str(t.number))
+        end = {TrialState.PRUNED: "x"}.get(t.state, "o" if t.user_attrs.get("solved") else None)
+        if end:
+            curves.plot(steps[-1], returns[-1], end, color=line.get_color())
+    curves.set_xlabel("policy steps")
+    curves.set_ylabel("evaluation reported to the pruner")
+    curves.set_title("trials: o solved, x pruned")
+    curves.legend(fontsize=7, ncol=2, title="trial", title_fontsize=7)
     return _save(fig, out)
 
 
@@ -130,7 +153,11 @@ def plot_importances(study, out: Path) -> Path | None:
     fig, ax = plt.subplots(figsize=(7, 0.4 * len(names) + 1.5))
     ax.barh(names, [importances[n] for n in names])
     ax.set_xlabel("importance")
-    ax.set_title(f"{study.study_name}: parameter importances")
+    complete = sum(t.state.name == "COMPLETE" for t in study.get_trials(deepcopy=False))
+    ax.set_title(
+        f"{study.study_name}: parameter importances (from {complete} completed trials"
+        + (": a hint, not a measurement)" if complete < 10 else ")")
+    )
     return _save(fig, out)
 
 
