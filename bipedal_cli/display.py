@@ -65,15 +65,26 @@ class TrainingDisplay:
             "return (avg 10)",
             _num(s.get("avg_return")),
         )
+        falls = s.get("last_eval_falls")
         table.add_row(
             "last eval",
-            _num(s.get("last_eval")),
+            _num(s.get("last_eval")) + (f" ({falls} fell)" if falls else ""),
             "alpha",
             _num(s.get("alpha"), "{:.4f}"),
             "critic loss",
             _num(s.get("critic_loss"), "{:.3f}"),
             "actor loss",
             _num(s.get("actor_loss"), "{:.2f}"),
+        )
+        table.add_row(
+            f"falls (last {s.get('falls_over') or 100})",
+            _num(s.get("fall_rate"), "{:.0%}"),
+            "q mean",
+            _num(s.get("q_mean")),
+            "entropy",
+            _num(s.get("entropy"), "{:.2f}"),
+            "",
+            "",
         )
         return table
 
@@ -94,8 +105,8 @@ class TrainingDisplay:
             self.console.print(
                 f"step {s['step']:,}  episodes {s.get('episodes', 0):,}  "
                 f"steps/s {_num(s.get('steps_per_s'))}  return (avg 10) "
-                f"{_num(s.get('avg_return'))}  last eval {_num(s.get('last_eval'))}  "
-                f"alpha {_num(s.get('alpha'), '{:.4f}')}",
+                f"{_num(s.get('avg_return'))}  falls {_num(s.get('fall_rate'), '{:.0%}')}  "
+                f"last eval {_num(s.get('last_eval'))}  alpha {_num(s.get('alpha'), '{:.4f}')}",
                 soft_wrap=True,
             )
 

@@ -110,6 +110,8 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
     _get(episode, "seed", int, where, "episode.")
     _get(data, "rng", Mapping, where)
     _get(data, "recent_returns", list, where)
+    if "recent_falls" in data:  # since 2026-11-24; older checkpoints start it empty
+        _get(data, "recent_falls", list, where)
     return cfg
 
 

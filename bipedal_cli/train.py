@@ -94,6 +94,7 @@ class Trainer:
         self.episodes = 0
         self.wall_time = 0.0
         self.recent_returns: deque[float] = deque(maxlen=100)
+        self.recent_falls: deque[bool] = deque(maxlen=100)
         self.last_eval: dict | None = None
         self.full_eval: dict | None = None
         self.last_metrics: dict[str, float] = {}
@@ -126,6 +127,7 @@ class Trainer:
             },
             "episode": self.runner.state_dict(self.act_dim),
             "recent_returns": list(self.recent_returns),
+            "recent_falls": list(self.recent_falls),
             "rng": {
                 "numpy": self.rng.bit_generator.state,
                 "torch": torch.get_rng_state(),
@@ -154,6 +156,7 @@ class Trainer:
         )
         self.env_steps = int(c.get("env_steps", self.step))
         self.recent_returns = deque(state["recent_returns"], maxlen=100)
+        self.recent_falls = deque(map(bool, state.get("recent_falls", [])), maxlen=100)
         self.rng.bit_generator.state = state["rng"]["numpy"]
         torch.set_rng_state(state["rng"]["torch"])
         if state["rng"].get("cuda") is not None and self.device.type == "cuda":
@@ -324,6 +327,7 @@ class Trainer:
             self.buffer.size = self.buffer.pos = 0
         self.last_eval = self.full_eval = None
         self.recent_returns.clear()
+        self.recent_falls.clear()
         self._start_episode()
 
     def _start_episode(self) -> None:
@@ -348,6 +352,7 @@ class Trainer:
     ) -> None:
         self.episodes += 1
         self.recent_returns.append(ep.env_ret)
+        self.recent_falls.append(bool(ep.fell))
         self.wall_time = wall_base + time.perf_counter() - session_start
         row = {
             "kind": "episode",
@@ -436,6 +441,13 @@ class Trainer:
             "last_return": recent[-1] if recent else None,
             "avg_return": float(np.mean(recent[-10:])) if recent else None,
             "last_eval": self.last_eval["mean"] if self.last_eval else None,
+            "last_eval_falls": (
+                f"{self.last_eval['falls']}/{self.last_eval['episodes']}"
+                if self.last_eval and "episodes" in self.last_eval
+                else None
+            ),
+            "fall_rate": float(np.mean(self.recent_falls)) if self.recent_falls else None,
+            "falls_over": len(self.recent_falls),
             "wall_time": self.wall_time,
             **self.last_metrics,
         }

@@ -84,3 +84,31 @@ def test_bad_checkpoint_files_raise_one_line_user_errors(tmp_path, content, mess
     with pytest.raises(UserError, match=message) as info:
         load_checkpoint(path)
     assert "\n" not in str(info.value) and str(path) in str(info.value)
+
+
+def test_the_displays_fall_rate_is_the_last_100_episodes_and_survives_a_resume(tmp_path):
+    import csv
+
+    from rich.console import Console
+
+    from bipedal_cli.display import TrainingDisplay
+    from bipedal_cli.resume import load_trainer
+
+    run = tmp_path / "run"
+    train(config_from_dict(tiny_dict(total_steps=3000, warmup_steps=3000)), run)  # random acts
+    rows = [r for r in csv.DictReader(open(run / "metrics.csv")) if r["kind"] == "episode"]
+    falls = [r["fell"] == "1" for r in rows][-100:]
+    assert 0 < sum(falls) < len(falls)  # a fall and a time limit
+    trainer = load_trainer(run)
+    snap = trainer.snapshot(0.0)
+    assert snap["fall_rate"] == pytest.approx(sum(falls) / len(falls))
+    assert snap["falls_over"] == len(falls)
+    display = TrainingDisplay(Console(width=200, record=True))
+    display.snapshot = snap
+    display.console.print(display.stats_table())
+    assert f"falls (last {len(falls)})" in display.console.export_text()
+    state = torch.load(run / "state.pt", weights_only=True)
+    del state["recent_falls"]  # a checkpoint from before the fall rate was kept
+    torch.save(state, run / "state.pt")
+    old = load_trainer(run)
+    assert old.snapshot(0.0)["fall_rate"] is None
