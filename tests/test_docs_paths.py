@@ -1,0 +1,59 @@
+"""Every file that README.md and docs/*.md name or show is in the repository: a figure's source
+(metrics.csv, eval JSON, benchmark output) that is not committed is not a source. Paths are
+checked against git's list of tracked and not-ignored files, as a fresh clone would have them."""
+
+import re
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+NAMED = re.compile(
+    r"(?<![\w/.])((?:docs|benchmarks|configs|checkpoints|bipedal_cli|tests)/[\w./-]*)"
+)
+LINKED = re.compile(r"\]\(([^)#\s]+)\)")
+
+
+def repository_files() -> set[str]:
+    out = subprocess.run(
+        ["git", "ls-files", "--cached", "--others", "--exclude-standard"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
+    if out.returncode != 0:
+        pytest.skip("not a git checkout")
+    files = set(out.stdout.split())
+    folders = {str(parent) + "/" for f in files for parent in Path(f).parents if str(parent) != "."}
+    return files | folders  # folders as "a/b/"
+
+
+def named_paths(doc: Path) -> set[str]:
+    text = doc.read_text()
+    paths = {
+        m.group(1).rstrip(".,:;")
+        for m in NAMED.finditer(text)
+        if text[m.end() : m.end() + 1] not in ("*", "{", "<")  # a pattern, not a path
+    }
+    for target in LINKED.findall(text):
+        if "://" not in target:
+            paths.add(str((doc.parent / target).resolve().relative_to(ROOT)))
+    return {p for p in paths if not re.search(r"[<>*{}]", p)}
+
+
+@pytest.mark.parametrize("doc", DOCS, ids=lambda d: d.name)
+def test_every_path_a_document_names_is_committed(doc):
+    files = repository_files()
+    missing = sorted(
+        p for p in named_paths(doc) if p not in files and p.rstrip("/") + "/" not in files
+    )
+    assert not missing, f"{doc.name} names files a fresh clone lacks: {missing}"
+
+
+def test_the_checker_sees_a_missing_path(tmp_path):
+    doc = ROOT / "docs" / "hardcore.md"
+    assert "docs/runs/hardcore-direct-seed0/eval-100.json" in named_paths(ROOT / "README.md")
+    assert "docs/images/hardcore_runs.png" in named_paths(doc)  # ](images/...) from docs/
+    assert "docs/runs/nope/metrics.csv" not in repository_files()
