@@ -2,10 +2,10 @@
 
 BipedalWalkerHardcore-v3 builds its obstacles as static boxes, measured in terrain steps
 (14/30 world units): a stump is a 1x1 or 2x2 box on the ground, each step of a staircase a 4x1
-box, and a pit two 1x4 walls with the gap between them. A fall is put down to the obstacle whose
-span lies nearest the hull's x when the episode ended, if one lies within ``REACH`` world units
-(about the walker's length), else to flat ground. This is a diagnostic: it says which obstacles
-a policy has not mastered, not why it fell.
+box, and a pit two 1x4 walls with the gap between them; a staircase counts as one obstacle. A
+fall is put down to the obstacle whose span lies nearest the hull's x when the episode ended, if
+one lies within ``REACH`` world units (about the walker's length), else to flat ground. This is
+a diagnostic: it says which obstacles a policy has not mastered, not why it fell.
 """
 
 from __future__ import annotations
@@ -42,19 +42,26 @@ def classify_box(vertices: Sequence[tuple[float, float]]) -> Span | None:
     return Span(found, min(xs), max(xs)) if found else None
 
 
-def merge_pits(spans: Iterable[Span]) -> list[Span]:
-    """Spans sorted by x, each pit's two walls joined into one span over the gap."""
+def merge_spans(spans: Iterable[Span]) -> list[Span]:
+    """Spans sorted by x, each pit's two walls joined into one span over the gap and each
+    staircase's steps (boxes that touch end to end) into one span."""
     merged: list[Span] = []
-    walls: list[Span] = []
+    wall: Span | None = None
     for span in sorted(spans, key=lambda s: s.x0):
-        if span.kind != "pit":
-            merged.append(span)
+        if span.kind == "pit" and wall is None:
+            wall = span
             continue
-        walls.append(span)
-        if len(walls) == 2:
-            merged.append(Span("pit", walls[0].x0, walls[1].x1))
-            walls = []
-    merged += walls  # an unpaired wall (none on an unmodified course) stays a pit of its own
+        if span.kind == "pit":
+            merged.append(Span("pit", wall.x0, span.x1))
+            wall = None
+            continue
+        last = merged[-1] if merged else None
+        if span.kind == "stairs" and last and last.kind == "stairs" and span.x0 - last.x1 < 1e-3:
+            merged[-1] = Span("stairs", last.x0, span.x1)
+            continue
+        merged.append(span)
+    if wall is not None:  # an unpaired wall (none on an unmodified course) is a pit of its own
+        merged.append(wall)
     return sorted(merged, key=lambda s: s.x0)
 
 
@@ -66,7 +73,7 @@ def course_obstacles(unwrapped_env) -> list[Span]:
             span = classify_box([tuple(v) for v in getattr(fixture.shape, "vertices", [])])
             if span is not None:
                 boxes.append(span)
-    return merge_pits(boxes)
+    return merge_spans(boxes)
 
 
 def fall_site(obstacles: Sequence[Span], hull_x: float, reach: float = REACH) -> str:

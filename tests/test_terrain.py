@@ -14,7 +14,7 @@ from bipedal_cli.terrain import (
     classify_box,
     course_obstacles,
     fall_site,
-    merge_pits,
+    merge_spans,
 )
 
 
@@ -33,9 +33,15 @@ def test_boxes_are_classified_by_their_size_in_terrain_steps():
     assert classify_box([(0, 0), (1, 1)]) is None  # the ground's edges
 
 
-def test_a_pits_two_walls_become_one_span_over_the_gap():
-    walls = [Span("pit", 10.0, 10.5), Span("stump", 2.0, 2.5), Span("pit", 12.0, 12.5)]
-    assert merge_pits(walls) == [Span("stump", 2.0, 2.5), Span("pit", 10.0, 12.5)]
+def test_a_pits_walls_and_a_staircases_steps_become_one_span_each():
+    boxes = [Span("pit", 10.0, 10.5), Span("stump", 2.0, 2.5), Span("pit", 12.0, 12.5)]
+    boxes += [Span("stairs", 20.0, 21.0), Span("stairs", 21.0, 22.0), Span("stairs", 23.0, 24.0)]
+    assert merge_spans(boxes) == [
+        Span("stump", 2.0, 2.5),
+        Span("pit", 10.0, 12.5),
+        Span("stairs", 20.0, 22.0),
+        Span("stairs", 23.0, 24.0),  # a gap: another staircase
+    ]
 
 
 def test_the_nearest_obstacle_within_reach_is_blamed_else_flat_ground():
