@@ -54,6 +54,6 @@ def test_every_path_a_document_names_is_committed(doc):
 
 def test_the_checker_sees_a_missing_path(tmp_path):
     doc = ROOT / "docs" / "hardcore.md"
-    assert "docs/runs/hardcore-direct-seed0/eval-100.json" in named_paths(ROOT / "README.md")
+    assert "checkpoints/bipedal_hardcore.eval.json" in named_paths(ROOT / "README.md")
     assert "docs/images/hardcore_runs.png" in named_paths(doc)  # ](images/...) from docs/
     assert "docs/runs/nope/metrics.csv" not in repository_files()
