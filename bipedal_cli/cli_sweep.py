@@ -51,21 +51,10 @@ def _study_table(study) -> Table:
     return table
 
 
-def _value(v) -> str:
-    return f"{v:.3g}" if isinstance(v, float) else str(v)
-
-
-HEADERS = {"batch_size": "batch", "warmup_steps": "warmup", "n_critics": "critics"}
-HEADERS["n_quantiles"] = "atoms"
-
-
-def _short(key: str) -> str:
-    """agent.n_quantiles -> n_quantiles: a parameter's name in a line."""
-    return key.rsplit(".", 1)[-1]
-
-
 def _params(params: dict) -> str:
-    return " ".join(f"{_short(k)}={_value(v)}" for k, v in params.items())
+    from .sweep_report import format_value
+
+    return " ".join(f"{k.rsplit('.', 1)[-1]}={format_value(v)}" for k, v in params.items())
 
 
 @sweep_app.callback(invoke_without_command=True)
@@ -162,7 +151,14 @@ def show(
     force: Annotated[bool, typer.Option("--force", help="Overwrite --best-config.")] = False,
 ) -> None:
     """A study's trials, best parameters, history and importance plots (PNG in its folder)."""
-    from .sweep_report import load_study, plot_history, plot_importances, trial_rows
+    from .sweep_report import (
+        format_value,
+        load_study,
+        plot_history,
+        plot_importances,
+        short_name,
+        trial_rows,
+    )
 
     if best_config is not None:
         check_output_path(best_config, "--best-config", (".yaml", ".yml"), force)
@@ -181,7 +177,7 @@ def show(
     params = Table(
         title="their parameters (base: the base config's own values)", box=box.SIMPLE_HEAD
     )
-    for col in ("trial", *(HEADERS.get(_short(k), _short(k)) for k in keys)):
+    for col in ("trial", *map(short_name, keys)):
         params.add_column(col, justify="right")
     for r in rows:
         best = r["best_eval"]
@@ -200,7 +196,7 @@ def show(
             "-" if r["test"] is None else f"{r['test']:.1f}",
             str(r["worker"] or "-").rpartition(":")[2] if len(hosts) < 2 else str(r["worker"]),
         )
-        params.add_row(number, *(_value(r["params"].get(k, "-")) for k in keys))
+        params.add_row(number, *(format_value(r["params"].get(k, "-")) for k in keys))
     console.print(table)
     console.print(params)
     console.print(_study_table(loaded))

@@ -14,6 +14,23 @@ from .paths import atomic_path
 from .sweep import DEFINITION
 from .sweep_storage import open_storage, redact
 
+SHORT_NAMES = {  # a searched key's name in a table's header
+    "agent.batch_size": "batch",
+    "train.warmup_steps": "warmup",
+    "agent.n_critics": "critics",
+    "agent.n_quantiles": "atoms",
+}
+
+
+def short_name(key: str) -> str:
+    """agent.n_quantiles -> atoms, agent.lr -> lr: a searched key in a table's header."""
+    return SHORT_NAMES.get(key, key.rsplit(".", 1)[-1])
+
+
+def format_value(value: Any) -> str:
+    """A parameter's value in a table: floats to 3 significant digits."""
+    return f"{value:.3g}" if isinstance(value, float) else str(value)
+
 
 def load_study(study: str, storage: str | None, study_dir: Path):
     import optuna

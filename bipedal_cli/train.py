@@ -443,10 +443,12 @@ class Trainer:
             "last_eval": self.last_eval["mean"] if self.last_eval else None,
             "last_eval_falls": (
                 f"{self.last_eval['falls']}/{self.last_eval['episodes']}"
-                if self.last_eval and "episodes" in self.last_eval
+                if self.last_eval
                 else None
             ),
-            "fall_rate": float(np.mean(self.recent_falls)) if self.recent_falls else None,
+            "fall_rate": sum(self.recent_falls) / len(self.recent_falls)
+            if self.recent_falls
+            else None,
             "falls_over": len(self.recent_falls),
             "wall_time": self.wall_time,
             **self.last_metrics,

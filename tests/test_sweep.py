@@ -71,6 +71,24 @@ def check_two_workers(trials, budget):
     assert len(pids) == 2, pids  # both workers ran trials
 
 
+def in_process(tmp_path, study, trials, steps, base=None, **settings):
+    """Settings of a tiny in-process study in ``tmp_path/sweeps`` over :data:`SPACE`."""
+    return SweepSettings(
+        study=study,
+        base=base or config_from_dict(tiny_dict(eval_every=100, warmup_steps=50)),
+        space=validate_space(SPACE, "test"),
+        trials=trials,
+        steps_per_trial=steps,
+        root=tmp_path / "sweeps",
+        **settings,
+    )
+
+
+def trial_metrics(tmp_path, study, number=0):
+    path = tmp_path / "sweeps" / study / f"trial-{number:04d}" / "metrics.csv"
+    return list(csv.DictReader(open(path)))
+
+
 def journal(tmp_path, study):
     path = tmp_path / "sweeps" / study / "journal.log"
     return optuna.storages.JournalStorage(optuna.storages.journal.JournalFileBackend(str(path)))
@@ -178,16 +196,7 @@ def test_a_killed_workers_trial_fails_and_reruns_on_a_journal_file(tmp_path, swe
 
 
 def test_a_trial_trailing_the_median_is_pruned_and_its_run_stops(tmp_path):
-    settings = SweepSettings(
-        study="prune",
-        base=config_from_dict(tiny_dict(eval_every=100, warmup_steps=50)),
-        space=validate_space(SPACE, "test"),
-        trials=4,
-        steps_per_trial=400,
-        pruner_startup=3,
-        pruner_warmup=0,
-        root=tmp_path / "sweeps",
-    )
+    settings = in_process(tmp_path, "prune", 4, 400, pruner_startup=3, pruner_warmup=0)
     (tmp_path / "sweeps" / "prune").mkdir(parents=True)
     storage = journal(tmp_path, "prune")
     study = optuna.create_study(study_name="prune", storage=storage)
@@ -226,15 +235,7 @@ def test_the_first_trial_is_the_base_config_so_the_search_has_a_baseline(tmp_pat
     )
     assert base_params(config_from_dict({"agent": {"n_quantiles": 25}}), steps) is None  # off-step
     for study, baseline in (("with", True), ("without", False)):
-        settings = SweepSettings(
-            study=study,
-            base=base,
-            space=space,
-            trials=2,
-            steps_per_trial=100,
-            baseline=baseline,
-            root=tmp_path / "sweeps",
-        )
+        settings = in_process(tmp_path, study, 2, 100, base, baseline=baseline)
         assert run_worker(settings, lambda n: None).ran == [0, 1]
         first, second = trials_of(study, journal(tmp_path, study))
         assert (first.params == base_params(base, space)) is baseline
@@ -244,17 +245,10 @@ def test_the_first_trial_is_the_base_config_so_the_search_has_a_baseline(tmp_pat
 
 def test_a_solved_trial_records_the_evaluation_and_the_test_that_solved_it(tmp_path):
     data = tiny_dict(eval_every=100, warmup_steps=50, solved_threshold=-1e6, solved_episodes=2)
-    settings = SweepSettings(
-        study="solve",
-        base=config_from_dict(data),
-        space=validate_space(SPACE, "test"),
-        trials=1,
-        steps_per_trial=300,
-        root=tmp_path / "sweeps",
-    )
+    settings = in_process(tmp_path, "solve", 1, 300, config_from_dict(data))
     assert run_worker(settings, lambda n: None).ran == [0]
     (trial,) = trials_of("solve", journal(tmp_path, "solve"))
-    rows = list(csv.DictReader(open(tmp_path / "sweeps" / "solve" / "trial-0000" / "metrics.csv")))
+    rows = trial_metrics(tmp_path, "solve")
     (periodic,) = [r for r in rows if r["kind"] == "eval"]  # solved at the first evaluation
     (test,) = [r for r in rows if r["kind"] == "full_eval"]
     assert trial.value == trial.user_attrs["env_steps"] == int(periodic["env_steps"]) == 100
@@ -264,17 +258,10 @@ def test_a_solved_trial_records_the_evaluation_and_the_test_that_solved_it(tmp_p
 
 
 def test_the_pruner_sees_each_trials_best_evaluation_so_far(tmp_path):
-    settings = SweepSettings(
-        study="best",
-        base=config_from_dict(tiny_dict(eval_every=100, warmup_steps=50)),
-        space=validate_space(SPACE, "test"),
-        trials=1,
-        steps_per_trial=400,
-        root=tmp_path / "sweeps",
-    )
+    settings = in_process(tmp_path, "best", 1, 400)
     run_worker(settings, lambda n: None)
     (trial,) = trials_of("best", journal(tmp_path, "best"))
-    rows = list(csv.DictReader(open(tmp_path / "sweeps" / "best" / "trial-0000" / "metrics.csv")))
+    rows = trial_metrics(tmp_path, "best")
     evals = [float(r["return"]) for r in rows if r["kind"] == "eval"]
     best_so_far = [-max(evals[: i + 1]) for i in range(len(evals))]
     assert len(evals) == 4 and len(set(evals)) > 1

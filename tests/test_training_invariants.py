@@ -158,7 +158,7 @@ def test_best_policy_is_the_actor_at_the_best_evaluation_of_its_env(tmp_path, mo
     def fake_evaluate(self, episodes):
         mean = next(means)
         seen[self.step] = {k: v.clone() for k, v in self.agent.actor.state_dict().items()}
-        return {"mean": mean, "std": 0.0, "mean_length": 1.0, "falls": 0}
+        return {"episodes": 20, "mean": mean, "std": 0.0, "mean_length": 1.0, "falls": 0}
 
     monkeypatch.setattr(Trainer, "evaluate", fake_evaluate)
     cfg = config_from_dict(tiny_dict(eval_every=100, warmup_steps=50, total_steps=400))
