@@ -127,6 +127,17 @@ class TQCAgent:
     def batch_to_tensors(self, batch: dict[str, np.ndarray]) -> dict[str, torch.Tensor]:
         return {k: torch.as_tensor(v, device=self.device) for k, v in batch.items()}
 
+    def set_learning_rate(self, lr: float) -> None:
+        """The Adam step size of actor, critics and temperature from the next update on (after
+        the critics' last step, which may still be running on the worker)."""
+        self.sync()
+        for opt in (self.actor_opt, self.critic_opt, self.alpha_opt):
+            for group in opt.param_groups:
+                group["lr"] = lr
+
+    def learning_rate(self) -> float:
+        return float(self.actor_opt.param_groups[0]["lr"])
+
     def update(self, batch: dict[str, torch.Tensor]) -> Mapping[str, torch.Tensor]:
         """One TQC step on a batch; returns detached 0-dim metric tensors (no host sync here).
 

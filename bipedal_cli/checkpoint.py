@@ -103,6 +103,11 @@ def recorded_evaluation(path: Path, env_id: str) -> float | None:
         return None
 
 
+def policy_step(path: Path) -> int:
+    """The policy step at which the policy file at ``path`` was saved."""
+    return int(load_checkpoint(path)["meta"]["steps"])
+
+
 def policy_payload(
     actor_state: dict, config: dict, obs_dim: int, act_dim: int, meta: dict
 ) -> dict[str, Any]:

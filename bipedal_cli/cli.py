@@ -123,19 +123,38 @@ def resume(
         int | None,
         typer.Option("--threads", help="CPU threads from now on (0: every core; same results)."),
     ] = None,
+    into: Annotated[
+        Path | None,
+        typer.Option("--into", help="Branch: continue in this new run directory under --config."),
+    ] = None,
+    config: Annotated[
+        Path | None,
+        typer.Option(
+            "--config",
+            help="With --into: the branch's config (the run's, plus a learning-rate decay that "
+            "starts at or after the run's step).",
+        ),
+    ] = None,
 ) -> None:
-    """Continue a run exactly where its last checkpoint left it."""
+    """Continue a run exactly where its last checkpoint left it (or branch it with --into)."""
     from .devices import resolve_device
     from .display import TrainingDisplay
+    from .resume import branch
     from .resume import resume as resume_run
 
     if steps is not None and steps < 0:
         raise UserError(f"--steps {steps}: expected the new total, a non-negative integer")
+    if (into is None) != (config is None):
+        raise UserError("--into and --config: a branch needs both (a plain resume needs neither)")
     if device:
         resolve_device(device)
-    result = resume_run(
-        run, steps, TrainingDisplay(console, "resume"), until_solved, device, threads
-    )
+    display = TrainingDisplay(console, "resume")
+    if into is not None:
+        explicit = {"device": device, "train.threads": threads, "train.total_steps": steps}
+        cfg = resolve_config(config, None, **explicit)
+        result = branch(run, into, cfg, display, until_solved, str(config))
+    else:
+        result = resume_run(run, steps, display, until_solved, device, threads)
     if hasattr(result, "stages"):
         _report_curriculum(result)
     else:

@@ -46,6 +46,13 @@ class AgentConfig:
     lr: float = 7.3e-4
     """Adam learning rate for actor, critics and temperature (rl-zoo's for this env; Table 1's
     mean, 3.296e-4, is configs/paper.yaml; docs/tuning.md compares them)."""
+    lr_final: float | None = None
+    """Learning rate at ``lr_decay_end``, reached linearly from ``lr`` at ``lr_decay_start``
+    (actor, critics and temperature alike; rl-zoo decays Hardcore's). None: ``lr`` throughout."""
+    lr_decay_start: int = 0
+    """Policy step where the decay begins (``lr`` up to here)."""
+    lr_decay_end: int = 0
+    """Policy step where the decay ends (``lr_final`` from here on)."""
     batch_size: int = 64
     """Transitions per gradient step."""
     tau: float = 0.005

@@ -83,8 +83,8 @@ class TrainingDisplay:
             _num(s.get("q_mean")),
             "entropy",
             _num(s.get("entropy"), "{:.2f}"),
-            "",
-            "",
+            "learning rate",
+            _num(s.get("lr"), "{:.2e}"),
         )
         return table
 

@@ -51,7 +51,7 @@ class MetricsWriter:
         with self.path.open(newline="") as f:
             header = next(csv.reader(f), [])
         if header != COLUMNS:  # written by an earlier version: add the new columns, empty
-            self._rewrite(read_metrics(self.path))
+            self.replace_rows(read_metrics(self.path))
 
     def write(self, row: dict[str, Any]) -> None:
         unknown = set(row) - set(COLUMNS)
@@ -69,9 +69,10 @@ class MetricsWriter:
     def truncate_after(self, step: int) -> None:
         """Drop rows logged after ``step`` (written after the checkpoint a resume starts from)."""
         rows = read_metrics(self.path)
-        self._rewrite([r for r in rows if int(float(r["step"])) <= step])
+        self.replace_rows([r for r in rows if int(float(r["step"])) <= step])
 
-    def _rewrite(self, rows: list[dict[str, str]]) -> None:
+    def replace_rows(self, rows: list[dict[str, str]]) -> None:
+        """The file holds ``rows`` alone, renamed into place whole."""
         with atomic_path(self.path) as tmp, tmp.open("w", newline="") as f:
             w = csv.DictWriter(f, COLUMNS, restval="")
             w.writeheader()

@@ -6,16 +6,27 @@ sits above both so that neither imports the other's caller.
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
-from .checkpoint import STATE_FILE, TRAIN_FORMAT, load_checkpoint
-from .config import config_from_dict
+from .checkpoint import (
+    BEST_POLICY_FILE,
+    STATE_FILE,
+    TRAIN_FORMAT,
+    atomic_write_text,
+    load_checkpoint,
+    policy_step,
+    recorded_evaluation,
+)
+from .config import Config, config_from_dict
 from .curriculum import continue_curriculum
 from .errors import UserError
-from .metrics import METRICS_FILE, MetricsWriter
+from .metrics import METRICS_FILE, MetricsWriter, read_metrics
+from .paths import atomic_path
 from .reporting import Reporter
-from .rundir import lock_run_dir
+from .rundir import BRANCH_FILE, lock_run_dir, prepare_new_run_dir
 from .train import Trainer
+from .validation import check_branch_config
 
 
 def state_path_of(path: str | Path) -> Path:
@@ -31,6 +42,18 @@ def state_path_of(path: str | Path) -> Path:
     return path / STATE_FILE
 
 
+def load_training_state(path: str | Path) -> tuple[Path, dict]:
+    """``state.pt`` of ``path`` (a run directory or the file), refused when policy-only."""
+    state_path = state_path_of(path)
+    state = load_checkpoint(state_path, "RUN_DIR_OR_CHECKPOINT")
+    if state["format"] != TRAIN_FORMAT:
+        raise UserError(
+            f"RUN_DIR_OR_CHECKPOINT {state_path}: a policy-only checkpoint cannot be resumed; "
+            f"expected the run's {STATE_FILE}"
+        )
+    return state_path, state
+
+
 def load_trainer(
     path: str | Path,
     reporter: Reporter | None = None,
@@ -43,13 +66,7 @@ def load_trainer(
     ``total_steps`` (the new budget) is checked against the run's step before anything is
     written; ``threads`` replaces ``train.threads`` (runs are the same bits on 1 or 2 threads).
     """
-    state_path = state_path_of(path)
-    state = load_checkpoint(state_path, "RUN_DIR_OR_CHECKPOINT")
-    if state["format"] != TRAIN_FORMAT:
-        raise UserError(
-            f"RUN_DIR_OR_CHECKPOINT {state_path}: a policy-only checkpoint cannot be resumed; "
-            f"expected the run's {STATE_FILE}"
-        )
+    state_path, state = load_training_state(path)
     step = int(state["counters"]["step"])
     if total_steps is not None and total_steps < step:
         raise UserError(
@@ -95,3 +112,38 @@ def resume(
                 )
             return continue_curriculum(trainer)
         return trainer.run(total_steps=total_steps, until_solved=until_solved)
+
+
+def branch(
+    path: str | Path,
+    into: str | Path,
+    cfg: Config,
+    reporter: Reporter | None = None,
+    until_solved: bool = False,
+    config_source: str = "--config",
+):
+    """Continue the run at ``path`` in a new directory ``into`` under ``cfg``, which may differ
+    from the run's config only by a learning-rate decay that starts at or after the run's step
+    (and device, threads, budget): the branch is then, to the bit, the run that ``cfg`` trains
+    from scratch, so two recipes can be compared from one shared start. The source is only
+    read; ``into`` gets the source's metrics up to the branch step and its best policy."""
+    state_path, state = load_training_state(path)
+    step = int(state["counters"]["step"])
+    if state.get("curriculum") is not None:
+        raise UserError(f"RUN_DIR_OR_CHECKPOINT {state_path}: a curriculum run cannot be branched")
+    run_cfg = config_from_dict(state["config"], f"{state_path}: config")
+    check_branch_config(run_cfg, cfg, step, config_source)
+    into = prepare_new_run_dir(into, "--into")
+    with lock_run_dir(into):
+        trainer = Trainer(cfg, into, reporter)
+        trainer.load_state_dict(state)
+        source_metrics = state_path.parent / METRICS_FILE
+        if source_metrics.exists():
+            rows = [r for r in read_metrics(source_metrics) if int(float(r["step"])) <= step]
+            MetricsWriter(into / METRICS_FILE).replace_rows(rows)
+        best = state_path.parent / BEST_POLICY_FILE
+        if recorded_evaluation(best, cfg.env) is not None and policy_step(best) <= step:
+            with atomic_path(into / BEST_POLICY_FILE) as tmp:
+                shutil.copyfile(best, tmp)
+        atomic_write_text(into / BRANCH_FILE, f"{state_path.resolve()} at step {step}\n")
+        return trainer.run(until_solved=until_solved)

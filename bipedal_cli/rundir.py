@@ -23,6 +23,7 @@ from .metrics import METRICS_FILE
 CONFIG_FILE = "config.yaml"
 PLOT_FILE = "learning_curve.png"
 LOCK_FILE = ".lock"
+BRANCH_FILE = "branched_from.txt"  # a branch's source: `<state.pt> at step <N>`
 
 
 @contextmanager

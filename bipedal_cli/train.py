@@ -3,10 +3,8 @@
 A run lives in one directory (:mod:`bipedal_cli.rundir`): ``config.yaml``, ``metrics.csv``,
 ``state.pt`` (everything an exact resume needs) and ``policy.pt`` (the actor alone).
 
-Exact resume: every source of randomness is one of three checkpointed generators (numpy for
-warm-up actions, episode seeds and replay sampling; a torch generator for exploration noise; the
-global torch RNG), and an episode cut by a checkpoint is rebuilt by replaying it
-(:mod:`bipedal_cli.episodes`).
+Exact resume (:mod:`bipedal_cli.run_state`): every source of randomness is checkpointed, and an
+episode cut by a checkpoint is rebuilt by replaying it.
 
 ``step`` counts policy steps: transitions stored, and updates. With ``agent.action_repeat`` = k
 each is k env steps (fewer at an episode's end); ``env_steps`` counts those.
@@ -29,10 +27,8 @@ from .agent import TQCAgent
 from .buffer import ReplayBuffer
 from .checkpoint import (
     BEST_POLICY_FILE,
-    FORMAT_VERSION,
     POLICY_FILE,
     STATE_FILE,
-    TRAIN_FORMAT,
     atomic_save,
     policy_payload,
     recorded_evaluation,
@@ -45,6 +41,7 @@ from .errors import UserError
 from .evaluation import actor_policy, evaluate_actor, run_episodes, summarize
 from .metrics import METRICS_FILE, MetricsWriter
 from .reporting import NullReporter, Reporter
+from .run_state import restore_run_state, run_state
 from .rundir import (
     default_run_dir,
     lock_run_dir,
@@ -53,6 +50,7 @@ from .rundir import (
     write_config,
     write_plot,
 )
+from .schedule import scheduled_learning_rate
 from .signals import stop_on_signals
 
 
@@ -107,72 +105,10 @@ class Trainer:
 
     # ----------------------------------------------------------------- state
     def state_dict(self) -> dict[str, Any]:
-        return {
-            "format": TRAIN_FORMAT,
-            "version": FORMAT_VERSION,
-            "config": self.cfg.to_dict(),
-            "env": self.cfg.env,
-            "obs_dim": self.obs_dim,
-            "act_dim": self.act_dim,
-            "agent": self.agent.state_dict(),
-            "buffer": {
-                k: torch.from_numpy(v) if isinstance(v, np.ndarray) else v
-                for k, v in self.buffer.state_dict().items()
-            },
-            "counters": {
-                "step": self.step,
-                "env_steps": self.env_steps,
-                "episodes": self.episodes,
-                "wall_time": self.wall_time,
-            },
-            "episode": self.runner.state_dict(self.act_dim),
-            "recent_returns": list(self.recent_returns),
-            "recent_falls": list(self.recent_falls),
-            "rng": {
-                "numpy": self.rng.bit_generator.state,
-                "torch": torch.get_rng_state(),
-                "cuda": torch.cuda.get_rng_state_all() if self.device.type == "cuda" else None,
-            },
-            "last_eval": self.last_eval,
-            "full_eval": self.full_eval,
-            "curriculum": self.curriculum,
-            # so that an episode ending right after a resume still logs its losses
-            "update_metrics": (
-                None
-                if self._update_metrics is None
-                else {k: float(v) for k, v in self._update_metrics.items()}
-            ),
-        }
+        return run_state(self)
 
     def load_state_dict(self, state: dict[str, Any]) -> None:
-        self.agent.load_state_dict(state["agent"])
-        buf = {k: v.numpy() if torch.is_tensor(v) else v for k, v in state["buffer"].items()}
-        self.buffer.load_state_dict(buf)
-        c = state["counters"]
-        self.step, self.episodes, self.wall_time = (
-            int(c["step"]),
-            int(c["episodes"]),
-            c["wall_time"],
-        )
-        self.env_steps = int(c.get("env_steps", self.step))
-        self.recent_returns = deque(state["recent_returns"], maxlen=100)
-        self.recent_falls = deque(map(bool, state.get("recent_falls", [])), maxlen=100)
-        self.rng.bit_generator.state = state["rng"]["numpy"]
-        torch.set_rng_state(state["rng"]["torch"])
-        if state["rng"].get("cuda") is not None and self.device.type == "cuda":
-            torch.cuda.set_rng_state_all(state["rng"]["cuda"])
-        self.last_eval, self.full_eval = state["last_eval"], state["full_eval"]
-        self.curriculum = state.get("curriculum")
-        m = state.get("update_metrics")
-        self._update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
-        ep = state["episode"]
-        if ep["obs"] is not None:
-            rebuilt = self.runner.replay(int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy())
-            if not rebuilt:
-                self.reporter.log(
-                    "warning: the replayed episode differs from the checkpoint's; the resumed "
-                    "run will not match an uninterrupted one exactly"
-                )
+        restore_run_state(self, state)
 
     def policy_meta(self) -> dict[str, Any]:
         return {
@@ -287,6 +223,9 @@ class Trainer:
                     break
                 self._env_step(metrics, wall_base, session_start)
                 if self.step > t.warmup_steps and len(self.buffer) >= cfg.agent.batch_size:
+                    lr = scheduled_learning_rate(self.step, cfg.agent)
+                    if lr is not None:
+                        self.agent.set_learning_rate(lr)
                     for _ in range(t.updates_per_step):
                         batch = self.agent.batch_to_tensors(
                             self.buffer.sample(cfg.agent.batch_size, self.rng)
@@ -451,6 +390,7 @@ class Trainer:
             else None,
             "falls_over": len(self.recent_falls),
             "wall_time": self.wall_time,
+            "lr": self.agent.learning_rate(),
             **self.last_metrics,
         }
 

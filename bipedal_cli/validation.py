@@ -81,6 +81,13 @@ def validate(cfg: Any, source: str) -> None:
         (a.action_repeat >= 1, "agent.action_repeat", "a positive integer"),
         (a.history >= 1, "agent.history", "a positive integer"),
         (a.n_step >= 1, "agent.n_step", "a positive integer"),
+        (a.lr_final is None or a.lr_final >= 0, "agent.lr_final", "null or a number >= 0"),
+        (a.lr_decay_start >= 0, "agent.lr_decay_start", "a non-negative integer"),
+        (
+            a.lr_final is None or a.lr_decay_end > a.lr_decay_start,
+            "agent.lr_decay_end",
+            "a step after agent.lr_decay_start (with agent.lr_final set)",
+        ),
         (t.reward_scale > 0, "train.reward_scale", "a positive number"),
         (t.total_steps >= 0, "train.total_steps", "a non-negative integer"),
         (t.warmup_steps >= 0, "train.warmup_steps", "a non-negative integer"),
@@ -124,4 +131,47 @@ def validate(cfg: Any, source: str) -> None:
             f"{source}: key 'train.buffer_size' expects a buffer that fits in memory: "
             f"{t.buffer_size:,} transitions need {need / 2**30:.1f} GiB, this machine has "
             f"{have / 2**30:.1f} GiB"
+        )
+
+
+BRANCH_MAY_CHANGE = ("device", "train.threads", "train.total_steps")
+LR_DECAY_KEYS = ("agent.lr_final", "agent.lr_decay_start", "agent.lr_decay_end")
+
+
+def _flat(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        if isinstance(value, dict):
+            out.update(_flat(value, f"{prefix}{key}."))
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
+
+
+def _lr_constant_until(agent: Any, step: int) -> bool:
+    return agent.lr_final is None or agent.lr_decay_start >= step
+
+
+def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> None:
+    """A branch of a run at ``step`` (``bipedal resume RUN --into DIR --config NEW``) must be the
+    run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
+    threads and budget (they do not change the bits), and a learning-rate decay that changes
+    nothing before ``step``. One line naming the first key that breaks this."""
+    old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
+    same_decay = all(old[k] == new[k] for k in LR_DECAY_KEYS)
+    both_constant = _lr_constant_until(run_cfg.agent, step) and _lr_constant_until(
+        new_cfg.agent, step
+    )
+    if not (same_decay or both_constant):
+        raise UserError(
+            f"{source}: key 'agent.lr_decay_start' expects a step at or after the branch point "
+            f"{step:,} (the run's learning rate up to there must stay as it was)"
+        )
+    for key, value in new.items():
+        if key in BRANCH_MAY_CHANGE or key in LR_DECAY_KEYS or old.get(key) == value:
+            continue
+        raise UserError(
+            f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
+            "change only device, train.threads, train.total_steps and a learning-rate decay "
+            "that starts at or after the branch point"
         )

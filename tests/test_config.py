@@ -20,6 +20,7 @@ SHIPPED = {
     "curriculum": ("BipedalWalker-v3", True, 1, 1, 1, None, 1.0),
     "hardcore": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-curriculum": ("BipedalWalker-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-lrdecay": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
 }
 
 
@@ -34,6 +35,19 @@ def test_shipped_configs_load_with_the_settings_their_comments_describe(name):
 
 def test_every_shipped_config_is_tested():
     assert {p.stem for p in CONFIGS.glob("*.yaml")} == set(SHIPPED)
+
+
+def test_hardcore_lrdecay_is_hardcore_until_its_decay_starts():
+    """It was trained as a branch of hardcore.yaml's run at step 1,092,168 (docs/hardcore.md)."""
+    from bipedal_cli.validation import check_branch_config
+
+    base, decay = (resolve_config(CONFIGS / f"{n}.yaml") for n in ("hardcore", "hardcore-lrdecay"))
+    assert base.agent.lr_final is None
+    a = decay.agent
+    assert (a.lr_final, a.lr_decay_start, a.lr_decay_end) == (7.3e-5, 1_100_000, 1_700_000)
+    check_branch_config(base, decay, 1_092_168, "hardcore-lrdecay.yaml")
+    with pytest.raises(UserError, match="lr_decay_start"):
+        check_branch_config(base, decay, 1_100_001, "hardcore-lrdecay.yaml")
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():

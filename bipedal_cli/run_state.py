@@ -1,0 +1,91 @@
+"""A training run's state, ``state.pt``: what it holds and how a Trainer is put back from it.
+
+Exact resume: every source of randomness is one of three checkpointed generators (numpy for
+warm-up actions, episode seeds and replay sampling; a torch generator for exploration noise; the
+global torch RNG), and an episode cut by a checkpoint is rebuilt by replaying it
+(:mod:`bipedal_cli.episodes`).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import Any
+
+import numpy as np
+import torch
+
+from .checkpoint import FORMAT_VERSION, TRAIN_FORMAT
+
+
+def run_state(trainer: Any) -> dict[str, Any]:
+    """Everything an exact resume needs, the ``state.pt`` of a
+    :class:`~bipedal_cli.train.Trainer`."""
+    return {
+        "format": TRAIN_FORMAT,
+        "version": FORMAT_VERSION,
+        "config": trainer.cfg.to_dict(),
+        "env": trainer.cfg.env,
+        "obs_dim": trainer.obs_dim,
+        "act_dim": trainer.act_dim,
+        "agent": trainer.agent.state_dict(),
+        "buffer": {
+            k: torch.from_numpy(v) if isinstance(v, np.ndarray) else v
+            for k, v in trainer.buffer.state_dict().items()
+        },
+        "counters": {
+            "step": trainer.step,
+            "env_steps": trainer.env_steps,
+            "episodes": trainer.episodes,
+            "wall_time": trainer.wall_time,
+        },
+        "episode": trainer.runner.state_dict(trainer.act_dim),
+        "recent_returns": list(trainer.recent_returns),
+        "recent_falls": list(trainer.recent_falls),
+        "rng": {
+            "numpy": trainer.rng.bit_generator.state,
+            "torch": torch.get_rng_state(),
+            "cuda": torch.cuda.get_rng_state_all() if trainer.device.type == "cuda" else None,
+        },
+        "last_eval": trainer.last_eval,
+        "full_eval": trainer.full_eval,
+        "curriculum": trainer.curriculum,
+        # so that an episode ending right after a resume still logs its losses
+        "update_metrics": (
+            None
+            if trainer._update_metrics is None
+            else {k: float(v) for k, v in trainer._update_metrics.items()}
+        ),
+    }
+
+
+def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
+    """Put ``trainer`` where :func:`run_state` left it; an episode cut by the checkpoint is
+    rebuilt by replaying its actions from its seed."""
+    trainer.agent.load_state_dict(state["agent"])
+    buf = {k: v.numpy() if torch.is_tensor(v) else v for k, v in state["buffer"].items()}
+    trainer.buffer.load_state_dict(buf)
+    c = state["counters"]
+    trainer.step, trainer.episodes, trainer.wall_time = (
+        int(c["step"]),
+        int(c["episodes"]),
+        c["wall_time"],
+    )
+    trainer.env_steps = int(c.get("env_steps", trainer.step))
+    trainer.recent_returns = deque(state["recent_returns"], maxlen=100)
+    trainer.recent_falls = deque(map(bool, state.get("recent_falls", [])), maxlen=100)
+    trainer.rng.bit_generator.state = state["rng"]["numpy"]
+    torch.set_rng_state(state["rng"]["torch"])
+    if state["rng"].get("cuda") is not None and trainer.device.type == "cuda":
+        torch.cuda.set_rng_state_all(state["rng"]["cuda"])
+    trainer.last_eval, trainer.full_eval = state["last_eval"], state["full_eval"]
+    trainer.curriculum = state.get("curriculum")
+    m = state.get("update_metrics")
+    trainer._update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
+    ep = state["episode"]
+    if ep["obs"] is not None:
+        rebuilt = trainer.runner.replay(int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy())
+        if not rebuilt:
+            trainer.reporter.log(
+                "warning: the replayed episode differs from the checkpoint's; the resumed "
+                "run will not match an uninterrupted one exactly"
+            )

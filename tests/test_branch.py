@@ -1,0 +1,118 @@
+"""The learning-rate decay and `bipedal resume RUN --into DIR --config NEW` (a branch)."""
+
+import pytest
+import torch
+
+from bipedal_cli.checkpoint import load_checkpoint
+from bipedal_cli.config import config_from_dict
+from bipedal_cli.errors import UserError
+from bipedal_cli.metrics import read_metrics
+from bipedal_cli.resume import branch
+from bipedal_cli.schedule import learning_rate_at
+from bipedal_cli.train import train
+
+from .conftest import tiny_dict
+from .test_train import assert_states_equal
+
+
+def test_learning_rate_is_constant_then_linear_then_final():
+    assert learning_rate_at(10**6, 1e-3, None, 0, 10) == 1e-3
+    assert learning_rate_at(100, 1e-3, 1e-4, 100, 200) == 1e-3
+    assert learning_rate_at(150, 1e-3, 1e-4, 100, 200) == pytest.approx(5.5e-4, rel=1e-12)
+    assert learning_rate_at(175, 1e-3, 0.0, 100, 200) == pytest.approx(2.5e-4, rel=1e-12)
+    assert learning_rate_at(200, 1e-3, 1e-4, 100, 200) == 1e-4
+    assert learning_rate_at(10**9, 1e-3, 1e-4, 100, 200) == 1e-4
+
+
+def decaying(**train_keys):
+    data = tiny_dict(**train_keys)
+    data["agent"].update(lr_final=1e-5, lr_decay_start=200, lr_decay_end=350)
+    return data
+
+
+def trainable_state(path):
+    state = load_checkpoint(path / "state.pt")
+    return {k: v for k, v in state.items() if k not in ("path", "config")}
+
+
+def test_branch_equals_the_run_its_config_trains_from_scratch(tmp_path):
+    straight = train(config_from_dict(decaying(total_steps=400)), tmp_path / "straight")
+    constant = train(config_from_dict(tiny_dict(total_steps=200)), tmp_path / "constant")
+    assert constant.steps == 200
+    branched = branch(tmp_path / "constant", tmp_path / "branch", config_from_dict(decaying()))
+    assert branched.steps == straight.steps == 400
+    assert_states_equal(
+        trainable_state(tmp_path / "straight"), trainable_state(tmp_path / "branch")
+    )
+    lrs = {
+        g["lr"]
+        for g in load_checkpoint(tmp_path / "branch" / "state.pt")["agent"]["actor_opt"][
+            "param_groups"
+        ]
+    }
+    assert lrs == {1e-5}
+    rows = [
+        [(r["step"], r["return"], r["critic_loss"]) for r in read_metrics(p / "metrics.csv")]
+        for p in (tmp_path / "straight", tmp_path / "branch")
+    ]
+    assert rows[0] == rows[1]
+    assert (tmp_path / "branch" / "branched_from.txt").read_text().endswith("at step 200\n")
+    # the source run is untouched, and the decay is not a no-op
+    assert load_checkpoint(tmp_path / "constant" / "state.pt")["counters"]["step"] == 200
+    constant_400 = train(config_from_dict(tiny_dict(total_steps=400)), tmp_path / "c400")
+    assert constant_400.episodes >= 1
+    a = load_checkpoint(tmp_path / "c400" / "state.pt")["agent"]["actor"]
+    b = load_checkpoint(tmp_path / "branch" / "state.pt")["agent"]["actor"]
+    assert any(not torch.equal(a[k], b[k]) for k in a)
+
+
+@pytest.mark.parametrize(
+    "change, key",
+    [
+        ({"agent": {"gamma": 0.99}}, "agent.gamma"),
+        ({"agent": {"lr_decay_start": 100}}, "agent.lr_decay_start"),
+        ({"train": {"buffer_size": 300}}, "train.buffer_size"),
+    ],
+)
+def test_branch_refuses_a_config_that_changes_the_past(tmp_path, change, key):
+    train(config_from_dict(tiny_dict(total_steps=200)), tmp_path / "run")
+    data = decaying()
+    for section, values in change.items():
+        data[section].update(values)
+    with pytest.raises(UserError, match=key.replace(".", r"\.")):
+        branch(
+            tmp_path / "run", tmp_path / "branch", config_from_dict(data), config_source="new.yaml"
+        )
+    assert not (tmp_path / "branch").exists()
+
+
+def test_branch_refuses_an_existing_run_dir(tmp_path):
+    train(config_from_dict(tiny_dict(total_steps=200)), tmp_path / "run")
+    with pytest.raises(UserError, match="--into"):
+        branch(tmp_path / "run", tmp_path / "run", config_from_dict(decaying()))
+
+
+def test_cli_branch_and_its_one_line_errors(tmp_path, capsys):
+    import yaml
+
+    from .test_cli import run_cli
+
+    base, branched = tmp_path / "base.yaml", tmp_path / "decay.yaml"
+    base.write_text(yaml.safe_dump(tiny_dict(total_steps=200)))
+    data = decaying(total_steps=300)
+    branched.write_text(yaml.safe_dump(data))
+    code, _, err = run_cli(["train", "--config", base, "--run-dir", tmp_path / "run"], capsys)
+    assert code == 0, err
+    code, _, err = run_cli(["resume", tmp_path / "run", "--into", tmp_path / "b"], capsys)
+    assert code == 2 and "--into and --config" in err and len(err.strip().splitlines()) == 1
+    data["agent"]["tau"] = 0.5
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data))
+    args = ["resume", tmp_path / "run", "--into", tmp_path / "b", "--config", bad]
+    code, _, err = run_cli(args, capsys)
+    assert code == 2 and f"{bad}: key 'agent.tau'" in err and len(err.strip().splitlines()) == 1
+    args = ["resume", tmp_path / "run", "--into", tmp_path / "b", "--config", branched]
+    code, out, err = run_cli(args, capsys)
+    assert code == 0, err
+    assert load_checkpoint(tmp_path / "b" / "state.pt")["counters"]["step"] == 300
+    assert load_checkpoint(tmp_path / "run" / "state.pt")["counters"]["step"] == 200
