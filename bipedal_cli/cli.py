@@ -1,4 +1,6 @@
-"""The ``bipedal`` command: parse, resolve config, call the library, print with rich.
+"""The ``bipedal`` command: the app, its commands (:mod:`~bipedal_cli.cli_train`,
+:mod:`~bipedal_cli.cli_policy`, :mod:`~bipedal_cli.cli_sweep`: each parses, resolves config,
+calls the library and prints with rich) and :func:`main`.
 
 Every :class:`UserError` (and every usage error) becomes one line on stderr and exit code 2.
 """
@@ -6,15 +8,10 @@ Every :class:`UserError` (and every usage error) becomes one line on stderr and 
 from __future__ import annotations
 
 import sys
-from pathlib import Path
-from typing import Annotated
 
 import typer
 
-from .cli_common import DeviceOpt, EnvOpt, console
-from .config import canonical_env_id, resolve_config
 from .errors import UserError
-from .paths import printable
 
 app = typer.Typer(
     add_completion=False,
@@ -30,189 +27,13 @@ _CLICK_ERRORS = (typer.TyperException,)
 _ABORTS = (typer.Abort,)
 
 
-def _summary_line(result) -> str:
-    minutes = result.wall_time / 60
-    why = {
-        "budget": "step budget reached",
-        "solved": "solved",
-        "interrupted": "interrupted, checkpoint saved",
-        "pruned": "pruned by the sweep",
-    }[result.stopped]
-    return (
-        f"{why}: {result.steps:,} steps ({result.env_steps or result.steps:,} env steps), "
-        f"{result.episodes:,} episodes, "
-        f"{minutes:.1f} min; run directory {printable(result.run_dir)}"
-    )
-
-
-def _report_result(result) -> None:
-    from .display import eval_table, verdict
-
-    console.print(_summary_line(result))
-    if result.full_eval:
-        console.print(eval_table(result.full_eval, "full evaluation"))
-        console.print(verdict(result.full_eval))
-    elif result.last_eval:
-        e = result.last_eval
-        console.print(
-            f"last evaluation ({e['episodes']} episodes at step {e['step']:,}): "
-            f"{e['mean']:.1f} +- {e['std']:.1f}"
-        )
-    run_dir = printable(result.run_dir)
-    console.print(f"policy: {run_dir}/policy.pt   resume: bipedal resume {run_dir}")
-
-
-@app.command()
-def train(
-    env: EnvOpt = None,
-    config: Annotated[Path | None, typer.Option("--config", help="YAML config file.")] = None,
-    set_: Annotated[
-        list[str] | None,
-        typer.Option("--set", help="Override a config key, e.g. --set agent.lr=3e-4 (repeatable)."),
-    ] = None,
-    steps: Annotated[int | None, typer.Option("--steps", help="Total env steps.")] = None,
-    seed: Annotated[int | None, typer.Option("--seed", help="Random seed.")] = None,
-    run_dir: Annotated[
-        Path | None,
-        typer.Option("--run-dir", help="Run directory (default runs/<env>-seed<S>-<time>)."),
-    ] = None,
-    device: DeviceOpt = None,
-    until_solved: Annotated[
-        bool,
-        typer.Option("--until-solved", help="Stop once the 100-episode evaluation passes 300."),
-    ] = False,
-) -> None:
-    """Train a new agent (default: BipedalWalker-v3 with the paper's hyperparameters)."""
-    from .display import TrainingDisplay
-    from .train import train as train_run
-
-    cfg = resolve_config(
-        config,
-        set_,
-        **{
-            "env": canonical_env_id(env) if env else None,
-            "seed": seed,
-            "device": device,
-            "train.total_steps": steps,
-        },
-    )
-    result = train_run(cfg, run_dir, TrainingDisplay(console, cfg.env), until_solved)
-    _report_result(result)
-    _exit_if_interrupted(result)
-
-
-def _exit_if_interrupted(result) -> None:
-    """128 + the signal's number after a run stopped by Ctrl-C (130) or SIGTERM (143)."""
-    if result.signal is not None:
-        from .signals import exit_status
-
-        sys.exit(exit_status(result.signal))
-
-
-@app.command()
-def resume(
-    run: Annotated[
-        Path, typer.Argument(metavar="RUN_DIR_OR_CHECKPOINT", help="Run directory or its state.pt.")
-    ],
-    steps: Annotated[
-        int | None, typer.Option("--steps", help="Train until this many env steps in all.")
-    ] = None,
-    until_solved: Annotated[bool, typer.Option("--until-solved")] = False,
-    device: DeviceOpt = None,
-    threads: Annotated[
-        int | None,
-        typer.Option("--threads", help="CPU threads from now on (0: every core; same results)."),
-    ] = None,
-    into: Annotated[
-        Path | None,
-        typer.Option("--into", help="Branch: continue in this new run directory under --config."),
-    ] = None,
-    config: Annotated[
-        Path | None,
-        typer.Option(
-            "--config",
-            help="With --into: the branch's config (the run's, plus a learning-rate decay that "
-            "starts at or after the run's step).",
-        ),
-    ] = None,
-) -> None:
-    """Continue a run exactly where its last checkpoint left it (or branch it with --into)."""
-    from .devices import resolve_device
-    from .display import TrainingDisplay
-    from .resume import branch
-    from .resume import resume as resume_run
-
-    if steps is not None and steps < 0:
-        raise UserError(f"--steps {steps}: expected the new total, a non-negative integer")
-    if (into is None) != (config is None):
-        raise UserError("--into and --config: a branch needs both (a plain resume needs neither)")
-    if device:
-        resolve_device(device)
-    display = TrainingDisplay(console, "resume")
-    if into is not None:
-        explicit = {"device": device, "train.threads": threads, "train.total_steps": steps}
-        cfg = resolve_config(config, None, **explicit)
-        result = branch(run, into, cfg, display, until_solved, str(config))
-    else:
-        result = resume_run(run, steps, display, until_solved, device, threads)
-    if hasattr(result, "stages"):
-        _report_curriculum(result)
-    else:
-        _report_result(result)
-    _exit_if_interrupted(result)
-
-
-@app.command()
-def curriculum(
-    config: Annotated[
-        Path | None,
-        typer.Option("--config", help="YAML config (default configs/curriculum.yaml values)."),
-    ] = None,
-    set_: Annotated[list[str] | None, typer.Option("--set", help="Override a config key.")] = None,
-    walker_steps: Annotated[
-        int | None, typer.Option("--walker-steps", help="Stage 1 budget (BipedalWalker-v3).")
-    ] = None,
-    hardcore_steps: Annotated[
-        int | None, typer.Option("--hardcore-steps", help="Stage 2 budget (Hardcore).")
-    ] = None,
-    replay: Annotated[
-        str | None, typer.Option("--replay", help="keep | clear the buffer at the switch.")
-    ] = None,
-    seed: Annotated[int | None, typer.Option("--seed")] = None,
-    run_dir: Annotated[Path | None, typer.Option("--run-dir")] = None,
-    device: DeviceOpt = None,
-) -> None:
-    """Walker until solved (or its budget), then Hardcore with the same agent."""
-    from .curriculum import start_curriculum
-    from .display import TrainingDisplay
-
-    cfg = resolve_config(
-        config,
-        set_,
-        **{
-            "seed": seed,
-            "device": device,
-            "curriculum.walker_steps": walker_steps,
-            "curriculum.hardcore_steps": hardcore_steps,
-            "curriculum.replay": replay,
-        },
-    )
-    result = start_curriculum(cfg, run_dir, TrainingDisplay(console, "curriculum"))
-    _report_curriculum(result)
-    _exit_if_interrupted(result)
-
-
-def _report_curriculum(result) -> None:
-    from .display import curriculum_table
-
-    console.print(curriculum_table(result, printable(result.run_dir)))
-    console.print(f"resume: bipedal resume {printable(result.run_dir)}")
-
-
 def _add_commands() -> None:
     from .cli_policy import eval_, export, info, plot, record
     from .cli_sweep import sweep_app
+    from .cli_train import curriculum, resume, train
 
+    for command in (train, resume, curriculum):
+        app.command()(command)
     app.command("eval")(eval_)
     for command in (record, plot, export, info):
         app.command()(command)

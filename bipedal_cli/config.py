@@ -123,6 +123,10 @@ class TrainConfig:
     flush_denormal: bool = True
     """Flush denormal floats to zero on CPU: Adam moments of dead units decay into the denormal
     range within a few thousand steps and then slow every update down by up to 2x."""
+    keep_policies: bool = False
+    """Also save the policy of every periodic evaluation, ``policies/step-<N>.pt`` (about 1.4 MB
+    each with Hardcore's networks), to choose among them afterwards on seeds that did not pick
+    them (``benchmarks/select_policy.py``). Changes nothing in training."""
     eval_seed: int = 1_000_000
     """First env seed of evaluation episodes (kept apart from training seeds)."""
     fall_penalty: float | None = None

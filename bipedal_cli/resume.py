@@ -60,11 +60,13 @@ def load_trainer(
     device: str | None = None,
     total_steps: int | None = None,
     threads: int | None = None,
+    keep_policies: bool | None = None,
 ) -> Trainer:
     """A Trainer restored from ``path`` (a run directory or its ``state.pt``), ready to run.
 
     ``total_steps`` (the new budget) is checked against the run's step before anything is
-    written; ``threads`` replaces ``train.threads`` (runs are the same bits on 1 or 2 threads).
+    written; ``threads`` and ``keep_policies`` replace ``train.threads`` and
+    ``train.keep_policies`` (neither changes the run's bits).
     """
     state_path, state = load_training_state(path)
     step = int(state["counters"]["step"])
@@ -76,9 +78,10 @@ def load_trainer(
     data = dict(state["config"])
     if device:
         data["device"] = device
-    if threads is not None:
-        data["train"] = {**data.get("train", {}), "threads": threads}
-    source = f"{state_path}: config" + (" + --threads" if threads is not None else "")
+    train_keys = {"threads": threads, "keep_policies": keep_policies}
+    options = {k: v for k, v in train_keys.items() if v is not None}
+    data["train"] = {**data.get("train", {}), **options}
+    source = f"{state_path}: config" + "".join(f" + --{k.replace('_', '-')}" for k in options)
     cfg = config_from_dict(data, source)
     trainer = Trainer(cfg, state_path.parent, reporter)
     trainer.load_state_dict(state)
@@ -95,6 +98,7 @@ def resume(
     until_solved: bool = False,
     device: str | None = None,
     threads: int | None = None,
+    keep_policies: bool | None = None,
 ):
     """Continue the run at ``path``; a curriculum run continues inside its current stage.
 
@@ -103,7 +107,7 @@ def resume(
     """
     run_dir = state_path_of(path).parent
     with lock_run_dir(run_dir):
-        trainer = load_trainer(path, reporter, device, total_steps, threads)
+        trainer = load_trainer(path, reporter, device, total_steps, threads, keep_policies)
         if trainer.curriculum is not None:
             if total_steps is not None:
                 raise UserError(

@@ -27,6 +27,7 @@ from .agent import TQCAgent
 from .buffer import ReplayBuffer
 from .checkpoint import (
     BEST_POLICY_FILE,
+    POLICIES_DIR,
     POLICY_FILE,
     STATE_FILE,
     atomic_save,
@@ -345,6 +346,9 @@ class Trainer:
         best = recorded_evaluation(self.run_dir / BEST_POLICY_FILE, self.cfg.env)
         if best is None or self.last_eval["mean"] > best:
             self.save_policy(self.run_dir / BEST_POLICY_FILE)
+        if t.keep_policies:
+            (self.run_dir / POLICIES_DIR).mkdir(exist_ok=True)
+            self.save_policy(self.run_dir / POLICIES_DIR / f"step-{self.step}.pt")
         solved = False
         if until_solved and self.last_eval["mean"] > t.solved_threshold:
             solved = self._full_test(metrics)

@@ -134,7 +134,7 @@ def validate(cfg: Any, source: str) -> None:
         )
 
 
-BRANCH_MAY_CHANGE = ("device", "train.threads", "train.total_steps")
+BRANCH_MAY_CHANGE = ("device", "train.threads", "train.total_steps", "train.keep_policies")
 LR_DECAY_KEYS = ("agent.lr_final", "agent.lr_decay_start", "agent.lr_decay_end")
 
 
@@ -155,8 +155,8 @@ def _lr_constant_until(agent: Any, step: int) -> bool:
 def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> None:
     """A branch of a run at ``step`` (``bipedal resume RUN --into DIR --config NEW``) must be the
     run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
-    threads and budget (they do not change the bits), and a learning-rate decay that changes
-    nothing before ``step``. One line naming the first key that breaks this."""
+    threads, budget and kept policies (they do not change the bits), and a learning-rate decay
+    that changes nothing before ``step``. One line naming the first key that breaks this."""
     old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
     same_decay = all(old[k] == new[k] for k in LR_DECAY_KEYS)
     both_constant = _lr_constant_until(run_cfg.agent, step) and _lr_constant_until(
@@ -172,6 +172,6 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
             continue
         raise UserError(
             f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
-            "change only device, train.threads, train.total_steps and a learning-rate decay "
-            "that starts at or after the branch point"
+            "change only device, train.threads, train.total_steps, train.keep_policies and a "
+            "learning-rate decay that starts at or after the branch point"
         )
