@@ -29,12 +29,14 @@ _ABORTS = (typer.Abort,)
 
 def _add_commands() -> None:
     from .cli_policy import eval_, export, info, plot, record
+    from .cli_select import select
     from .cli_sweep import sweep_app
     from .cli_train import curriculum, resume, train
 
     for command in (train, resume, curriculum):
         app.command()(command)
     app.command("eval")(eval_)
+    app.command()(select)
     for command in (record, plot, export, info):
         app.command()(command)
     app.add_typer(sweep_app, name="sweep")

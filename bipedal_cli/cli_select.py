@@ -1,0 +1,112 @@
+"""``bipedal select``: choose a run's policy on held-out seeds (:mod:`bipedal_cli.selection`;
+registered on the app by :mod:`bipedal_cli.cli`)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from .cli_common import console
+from .errors import UserError
+from .paths import atomic_path, check_output_path, printable
+from .selection import HELD_OUT_SEED, run_candidates, top_candidates
+from .validation import check_count, check_seeds
+
+
+def select(
+    runs: Annotated[list[Path], typer.Argument(metavar="RUN_DIR...", help="Run directories.")],
+    top: Annotated[
+        int, typer.Option("--top", help="Candidates: the best K by periodic evaluation.")
+    ] = 5,
+    episodes: Annotated[int, typer.Option("--episodes", help="Held-out episodes each.")] = 100,
+    seed: Annotated[
+        int, typer.Option("--seed", help="Held-out env seeds S.. (not eval's 0-99).")
+    ] = HELD_OUT_SEED,
+    out: Annotated[
+        Path | None, typer.Option("--out", help="Copy the chosen policy file here.")
+    ] = None,
+    json_out: Annotated[
+        Path | None, typer.Option("--json", help="Write every candidate's scores.")
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite --out / --json.")] = False,
+    workers: Annotated[int, typer.Option("--workers", help="Processes (0: every core).")] = 0,
+) -> None:
+    """Choose among runs' policies: the top K by periodic evaluation, re-evaluated on held-out
+    seeds; the best there is the choice (its `bipedal eval` is then a clean estimate)."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    from .checkpoint import actor_from_checkpoint, load_checkpoint
+    from .evaluation import evaluate_actor, summarize
+
+    check_count("--top", top)
+    check_count("--episodes", episodes)
+    check_seeds("--seed", seed, episodes)
+    if workers < 0:
+        raise UserError("--workers: expected 0 (every core) or a positive integer")
+    for path, option in ((out, "--out"), (json_out, "--json")):
+        if path is not None:
+            check_output_path(path, option, force=force)
+    pool = [c for run in runs for c in run_candidates(run)]
+    envs = {c.env for c in pool}
+    if len(envs) > 1:
+        raise UserError(f"RUN_DIR: the runs' policies are for different envs: {sorted(envs)}")
+    chosen = top_candidates(pool, top)
+    seeds = list(range(seed, seed + episodes))
+    scores = []
+    with Progress(
+        "[bold]held-out", BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console
+    ) as progress:
+        task = progress.add_task("select", total=len(chosen) * episodes)
+        for c in chosen:
+            actor, cfg = actor_from_checkpoint(load_checkpoint(c.path))
+            results = evaluate_actor(
+                actor,
+                cfg.agent,
+                c.env,
+                seeds,
+                workers,
+                on_episodes=lambda n: progress.advance(task, n),
+            )
+            scores.append(summarize(results, cfg.train.solved_threshold))
+    best = max(range(len(chosen)), key=lambda i: scores[i]["mean"])
+    console.print(_table(chosen, scores, best, seeds))
+    winner = chosen[best]
+    console.print(f"chosen: {printable(winner.path)} (step {winner.step:,})")
+    if out is not None:
+        with atomic_path(out) as tmp:
+            shutil.copyfile(winner.path, tmp)
+        console.print(f"copied to {printable(out)}; report its score with `bipedal eval {out}`")
+    if json_out is not None:
+        rows = [
+            {"path": str(c.path), "step": c.step, "periodic": c.periodic, "held_out": s}
+            for c, s in zip(chosen, scores, strict=True)
+        ]
+        payload = {"seeds": [seeds[0], seeds[-1]], "chosen": str(winner.path), "candidates": rows}
+        with atomic_path(json_out) as tmp:
+            tmp.write_text(json.dumps(payload, indent=1))
+
+
+def _table(chosen, scores, best: int, seeds: list[int]) -> Table:
+    from .display import falls_text
+
+    table = Table(title=f"held-out env seeds {seeds[0]}..{seeds[-1]}")
+    for col in ("", "run", "step", "periodic", "held-out mean", "std", "median", "falls"):
+        table.add_column(col, justify="right")
+    for i, (c, s) in enumerate(zip(chosen, scores, strict=True)):
+        periodic = "-" if c.periodic is None else f"{c.periodic:.1f} ({c.periodic_falls} falls)"
+        table.add_row(
+            "*" if i == best else "",
+            printable(c.run),
+            f"{c.step:,}",
+            periodic,
+            f"{s['mean']:.1f}",
+            f"{s['std']:.1f}",
+            f"{s['median']:.1f}",
+            falls_text(s),
+        )
+    return table

@@ -1,0 +1,71 @@
+"""Choosing a run's policy on seeds that did not pick it.
+
+A run's periodic evaluations (20 episodes on seeds from ``train.eval_seed``) rank its kept
+policies (``train.keep_policies``), its ``best_policy.pt`` and its ``policy.pt``. The best of
+many noisy 20-episode means is biased upward (the winner's curse), and choosing among them with
+``bipedal eval``'s seeds 0-99 would bias the reported score the same way. So the top few are
+evaluated again on held-out seeds (2,000,000 on by default) and the best there is the choice;
+its ``bipedal eval`` on seeds 0-99 is then a clean estimate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from .checkpoint import BEST_POLICY_FILE, POLICIES_DIR, POLICY_FILE, load_checkpoint
+from .errors import UserError
+
+HELD_OUT_SEED = 2_000_000  # apart from eval's 0-99 and the periodic evaluations' 1,000,000 on
+
+
+@dataclass
+class Candidate:
+    path: Path
+    run: str
+    step: int  # policy steps
+    env: str
+    periodic: float | None  # the periodic evaluation's mean at this very step, if there was one
+    periodic_falls: int | None
+
+
+def describe(path: Path) -> Candidate:
+    """A policy file as a candidate, with the periodic evaluation it records for its own step."""
+    meta = load_checkpoint(path, "RUN_DIR")["meta"]
+    step = int(meta["steps"])
+    last = meta.get("last_eval") or {}
+    at_step = last.get("step") == step
+    run = path.parent.parent if path.parent.name == POLICIES_DIR else path.parent
+    return Candidate(
+        path,
+        run.name,
+        step,
+        meta["env"],
+        float(last["mean"]) if at_step else None,
+        int(last["falls"]) if at_step else None,
+    )
+
+
+def run_candidates(run_dir: Path) -> list[Candidate]:
+    """The kept policies, ``best_policy.pt`` and ``policy.pt`` of a run, one per step."""
+    if not run_dir.is_dir():
+        raise UserError(f"RUN_DIR {run_dir}: not a run directory")
+    paths = sorted((run_dir / POLICIES_DIR).glob("step-*.pt"))
+    paths += [p for p in (run_dir / BEST_POLICY_FILE, run_dir / POLICY_FILE) if p.is_file()]
+    if not paths:
+        raise UserError(f"RUN_DIR {run_dir}: holds no policy ({POLICY_FILE}, {POLICIES_DIR}/)")
+    by_step: dict[int, Candidate] = {}
+    for path in paths:
+        found = describe(path)
+        by_step.setdefault(found.step, found)
+    return list(by_step.values())
+
+
+def top_candidates(candidates: list[Candidate], k: int) -> list[Candidate]:
+    """The ``k`` best by periodic evaluation (later steps first among ties); candidates with
+    none come after all that have one, latest first."""
+
+    def key(c: Candidate) -> tuple[bool, float, int]:
+        return (c.periodic is not None, c.periodic or 0.0, c.step)
+
+    return sorted(candidates, key=key, reverse=True)[:k]

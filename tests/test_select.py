@@ -1,0 +1,57 @@
+"""bipedal select: ranking by periodic evaluation, re-evaluation on held-out seeds."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from bipedal_cli.checkpoint import load_checkpoint
+from bipedal_cli.config import config_from_dict
+from bipedal_cli.errors import UserError
+from bipedal_cli.selection import Candidate, run_candidates, top_candidates
+from bipedal_cli.train import train
+
+from .conftest import tiny_dict
+from .test_cli import run_cli
+
+
+def candidate(step, periodic):
+    return Candidate(Path(f"step-{step}.pt"), "run", step, "BipedalWalker-v3", periodic, 0)
+
+
+def test_top_candidates_rank_by_periodic_evaluation_then_step():
+    pool = [candidate(100, 5.0), candidate(200, None), candidate(300, 9.0), candidate(400, 5.0)]
+    assert [c.step for c in top_candidates(pool, 3)] == [300, 400, 100]
+    assert [c.step for c in top_candidates(pool, 10)] == [300, 400, 100, 200]
+
+
+@pytest.fixture
+def kept_run(tmp_path):
+    data = tiny_dict(total_steps=300, eval_every=100)
+    data["train"]["keep_policies"] = True
+    train(config_from_dict(data), tmp_path / "run")
+    return tmp_path / "run"
+
+
+def test_run_candidates_are_one_per_step_with_their_own_evaluation(kept_run):
+    found = run_candidates(kept_run)
+    assert sorted(c.step for c in found) == [100, 200, 300]
+    assert all(c.periodic is not None for c in found)
+    with pytest.raises(UserError, match="not a run directory"):
+        run_candidates(kept_run / "missing")
+
+
+def test_select_copies_the_held_out_winner(tmp_path, kept_run, capsys):
+    out, report = tmp_path / "chosen.pt", tmp_path / "select.json"
+    args = ["select", kept_run, "--top", 2, "--episodes", 2, "--workers", 1, "--out", out]
+    code, stdout, err = run_cli([*args, "--json", report], capsys)
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    assert data["seeds"] == [2_000_000, 2_000_001] and len(data["candidates"]) == 2
+    means = {r["path"]: r["held_out"]["mean"] for r in data["candidates"]}
+    assert means[data["chosen"]] == max(means.values())
+    chosen_step = load_checkpoint(data["chosen"])["meta"]["steps"]
+    assert load_checkpoint(out)["meta"]["steps"] == chosen_step
+    assert "chosen:" in stdout
+    code, _, err = run_cli([*args], capsys)  # --out exists now
+    assert code == 2 and "--force" in err and len(err.strip().splitlines()) == 1
