@@ -14,7 +14,7 @@ from rich.table import Table
 from .cli_common import console
 from .errors import UserError
 from .paths import atomic_path, check_output_path, printable
-from .selection import HELD_OUT_SEED, run_candidates, top_candidates
+from .selection import HELD_OUT_SEED, distinct, run_candidates, top_candidates
 from .validation import check_count, check_seeds
 
 
@@ -51,7 +51,7 @@ def select(
     for path, option in ((out, "--out"), (json_out, "--json")):
         if path is not None:
             check_output_path(path, option, force=force)
-    pool = [c for run in runs for c in run_candidates(run)]
+    pool = distinct([c for run in runs for c in run_candidates(run)])
     envs = {c.env for c in pool}
     if len(envs) > 1:
         raise UserError(f"RUN_DIR: the runs' policies are for different envs: {sorted(envs)}")

@@ -10,6 +10,7 @@ its ``bipedal eval`` on seeds 0-99 is then a clean estimate.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -59,6 +60,19 @@ def run_candidates(run_dir: Path) -> list[Candidate]:
         found = describe(path)
         by_step.setdefault(found.step, found)
     return list(by_step.values())
+
+
+def distinct(candidates: list[Candidate]) -> list[Candidate]:
+    """One candidate per policy file content: a branch's copy of its source's best policy, or
+    a ``best_policy.pt`` equal to a kept one, is evaluated once (the first named wins)."""
+    seen: set[str] = set()
+    out = []
+    for c in candidates:
+        digest = hashlib.sha256(c.path.read_bytes()).hexdigest()
+        if digest not in seen:
+            seen.add(digest)
+            out.append(c)
+    return out
 
 
 def top_candidates(candidates: list[Candidate], k: int) -> list[Candidate]:

@@ -8,7 +8,7 @@ import pytest
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict
 from bipedal_cli.errors import UserError
-from bipedal_cli.selection import Candidate, run_candidates, top_candidates
+from bipedal_cli.selection import Candidate, distinct, run_candidates, top_candidates
 from bipedal_cli.train import train
 
 from .conftest import tiny_dict
@@ -37,6 +37,12 @@ def test_run_candidates_are_one_per_step_with_their_own_evaluation(kept_run):
     found = run_candidates(kept_run)
     assert sorted(c.step for c in found) == [100, 200, 300]
     assert all(c.periodic is not None for c in found)
+    branch = kept_run.parent / "branch"  # a branch's copy of its source's best policy
+    branch.mkdir()
+    (branch / "best_policy.pt").write_bytes((kept_run / "policies" / "step-100.pt").read_bytes())
+    pool = distinct(found + run_candidates(branch))
+    assert sorted(c.step for c in pool) == [100, 200, 300]
+    assert all(c.run == "run" for c in pool)
     with pytest.raises(UserError, match="not a run directory"):
         run_candidates(kept_run / "missing")
 
