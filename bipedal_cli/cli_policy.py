@@ -173,13 +173,19 @@ def plot(
             "--metric", help="return | alpha | critic_loss | actor_loss | entropy | q_mean | length"
         ),
     ] = "return",
+    window: Annotated[int, typer.Option("--window", help="Episodes per moving mean.")] = 10,
+    since: Annotated[
+        int, typer.Option("--since", help="Draw from this many env steps on (zoom in).")
+    ] = 0,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
-    """Learning curves: 10-episode moving mean with a +-1 std band, evaluations, the 300 line."""
+    """Learning curves: moving mean with a +-1 std band, evaluations, the 300 line."""
     from .plotting import PLOT_SUFFIXES, plot_runs
 
+    check_count("--window", window)
+    check_count("--since", since, limit=10**12, low=0)
     check_output_path(out, "--out", PLOT_SUFFIXES, force)
-    plot_runs(runs, out, label, aggregate, title, metric=metric)
+    plot_runs(runs, out, label, aggregate, title, metric=metric, window=window, since=since)
     console.print(f"wrote {out}")
 
 

@@ -77,12 +77,14 @@ def moving_stats(values: np.ndarray, window: int = 10) -> tuple[np.ndarray, np.n
 
 
 def aggregate(
-    curves: list[RunCurve], points: int = 200
+    curves: list[RunCurve], points: int = 200, window: int = 10
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Across runs: the 10-episode moving mean interpolated on a common step grid -> mean, std."""
+    """Across runs: the moving mean interpolated on a common step grid -> mean, std."""
     end = min(c.steps[-1] for c in curves)
     grid = np.linspace(0, end, points)
-    stacked = np.stack([np.interp(grid, c.steps, moving_stats(c.values)[0]) for c in curves])
+    stacked = np.stack(
+        [np.interp(grid, c.steps, moving_stats(c.values, window)[0]) for c in curves]
+    )
     return grid, stacked.mean(0), stacked.std(0)
 
 
@@ -94,9 +96,12 @@ def plot_runs(
     title: str | None = None,
     threshold: float = 300.0,
     metric: str = "return",
+    window: int = 10,
+    since: float = 0.0,
 ) -> Path:
-    """Episode return against env steps: moving mean over 10 episodes with +-1 std band,
-    evaluations as points, the solved line; several runs overlaid, or averaged per label."""
+    """Episode return against env steps: moving mean over ``window`` episodes with +-1 std
+    band, evaluations as points, the solved line; several runs overlaid, or averaged per label.
+    Only env steps from ``since`` on are drawn (the moving statistics still see earlier ones)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -122,19 +127,24 @@ def plot_runs(
         color = colors[i % len(colors)]
         label = key.split("#")[0]
         if len(members) > 1:
-            grid, mean, std = aggregate(members)
-            ax.plot(grid, back(mean), color=color, label=f"{label} (mean of {len(members)} runs)")
-            ax.fill_between(grid, back(mean - std), back(mean + std), color=color, alpha=0.2)
+            grid, mean, std = aggregate(members, window=window)
+            name = f"{label} (mean of {len(members)} runs)"
         else:
-            c = members[0]
-            mean, std = moving_stats(c.values)
-            ax.plot(c.steps, back(mean), color=color, label=f"{label}")
-            ax.fill_between(c.steps, back(mean - std), back(mean + std), color=color, alpha=0.2)
+            grid, (mean, std), name = (
+                members[0].steps,
+                moving_stats(members[0].values, window),
+                label,
+            )
+        shown = grid >= since
+        grid, mean, std = grid[shown], mean[shown], std[shown]
+        ax.plot(grid, back(mean), color=color, label=name)
+        ax.fill_between(grid, back(mean - std), back(mean + std), color=color, alpha=0.2)
         for c in members:
-            if len(c.eval_steps):
+            evals = c.eval_steps >= since
+            if evals.any():
                 ax.scatter(
-                    c.eval_steps,
-                    c.eval_means,
+                    c.eval_steps[evals],
+                    c.eval_means[evals],
                     color=color,
                     s=14,
                     marker="o",
@@ -162,9 +172,9 @@ def plot_runs(
     ax.set_xlabel("env steps")
     ax.set_ylabel("episode return" if metric == "return" else f"{metric} (at episode end)")
     default_title = (
-        "moving geometric mean over 10 episodes (band: x/÷ 1 geometric std)"
+        f"moving geometric mean over {window} episodes (band: x/÷ 1 geometric std)"
         if log_space
-        else "moving mean over 10 episodes (band: +-1 std)"
+        else f"moving mean over {window} episodes (band: +-1 std)"
     )
     if metric == "return":
         default_title += "; points: evaluations"

@@ -216,5 +216,6 @@ def test_installed_console_script_lists_every_command():
         env={"COLUMNS": "200", "PATH": str(script.parent)},
     )
     assert proc.returncode == 0, proc.stderr
-    for command in ("train", "resume", "eval", "record", "curriculum", "plot", "export", "info"):
+    commands = ("train", "resume", "curriculum", "eval", "select", "record", "plot", "export")
+    for command in (*commands, "info", "sweep"):
         assert f" {command} " in proc.stdout, f"`{command}` missing from bipedal --help"

@@ -73,6 +73,16 @@ def test_plot_overlays_runs_and_train_wrote_its_own(tmp_path, trained, capsys):
     assert text.startswith("<?xml") and "mean of 2 runs" in text
 
 
+def test_plot_zooms_in_and_smooths_over_a_chosen_window(tmp_path, trained, capsys):
+    out = tmp_path / "zoom.svg"
+    args = ["plot", trained, "--window", 3, "--since", 60, "--out", out]
+    code, _, err = run_cli(args, capsys)
+    assert code == 0, err
+    assert "moving mean over 3 episodes" in out.read_text()
+    code, _, err = run_cli(["plot", trained, "--window", 0, "--out", tmp_path / "w.svg"], capsys)
+    assert code == 2 and "--window 0" in err
+
+
 def test_export_gives_the_checkpoints_actions_with_torch_alone(tmp_path, trained, capsys):
     out = tmp_path / "policy.pt2"
     code, _, err = run_cli(["export", trained / "policy.pt", "--out", out], capsys)
