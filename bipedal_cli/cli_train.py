@@ -122,8 +122,12 @@ def resume(
         typer.Option(
             "--config",
             help="With --into: the branch's config (the run's, plus a learning-rate decay that "
-            "starts at or after the run's step).",
+            "starts at or after the run's step; default: the run's own).",
         ),
+    ] = None,
+    set_: Annotated[
+        list[str] | None,
+        typer.Option("--set", help="With --into: override a key of the branch's config."),
     ] = None,
 ) -> None:
     """Continue a run exactly where its last checkpoint left it (or branch it with --into)."""
@@ -134,8 +138,12 @@ def resume(
 
     if steps is not None and steps < 0:
         raise UserError(f"--steps {steps}: expected the new total, a non-negative integer")
-    if (into is None) != (config is None):
-        raise UserError("--into and --config: a branch needs both (a plain resume needs neither)")
+    if into is None and (config is not None or set_):
+        raise UserError(
+            "--config and --set: only with --into (a branch); a resume keeps its config"
+        )
+    if into is not None and config is None and not set_:
+        raise UserError("--into: a branch needs --config FILE or --set key=value to change")
     if device:
         resolve_device(device)
     display = TrainingDisplay(console, "resume")
@@ -146,8 +154,13 @@ def resume(
             "train.total_steps": steps,
             "train.keep_policies": keep_policies,
         }
-        cfg = resolve_config(config, None, **explicit)
-        result = branch(run, into, cfg, display, until_solved, str(config))
+        if config is not None:
+            cfg = resolve_config(config, set_, **explicit)
+            result = branch(run, into, cfg, display, until_solved, str(config))
+        else:
+            result = branch(
+                run, into, None, display, until_solved, overrides=set_, explicit=explicit
+            )
     else:
         result = resume_run(run, steps, display, until_solved, device, threads, keep_policies)
     if hasattr(result, "stages"):

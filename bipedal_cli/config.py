@@ -7,6 +7,7 @@ YAML file, the YAML file over the dataclass defaults. Unknown keys and wrong typ
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import types
@@ -294,7 +295,17 @@ def resolve_config(
     ``explicit`` maps dotted keys (``'train.total_steps'``) to values from dedicated options.
     """
     data: dict[str, Any] = load_yaml(config_path) if config_path else {}
-    source = str(config_path) if config_path else "config"
+    return override_config(
+        data, str(config_path) if config_path else "config", overrides, **explicit
+    )
+
+
+def override_config(
+    data: dict[str, Any], source: str, overrides: list[str] | None = None, **explicit: Any
+) -> Config:
+    """``data`` (a config as a dict, named ``source`` in errors) with ``--set`` overrides, then
+    explicit CLI options that are not None, resolved."""
+    data = copy.deepcopy(data)
     for text in overrides or []:
         path, value = parse_override(text)
         _set_nested(data, path, value)

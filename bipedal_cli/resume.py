@@ -18,7 +18,7 @@ from .checkpoint import (
     policy_step,
     recorded_evaluation,
 )
-from .config import Config, config_from_dict
+from .config import Config, config_from_dict, override_config
 from .curriculum import continue_curriculum
 from .errors import UserError
 from .metrics import METRICS_FILE, MetricsWriter, read_metrics
@@ -121,21 +121,29 @@ def resume(
 def branch(
     path: str | Path,
     into: str | Path,
-    cfg: Config,
+    cfg: Config | None = None,
     reporter: Reporter | None = None,
     until_solved: bool = False,
     config_source: str = "--config",
+    overrides: list[str] | None = None,
+    explicit: dict | None = None,
 ):
-    """Continue the run at ``path`` in a new directory ``into`` under ``cfg``, which may differ
-    from the run's config only by a learning-rate decay that starts at or after the run's step
-    (and device, threads, budget): the branch is then, to the bit, the run that ``cfg`` trains
-    from scratch, so two recipes can be compared from one shared start. The source is only
-    read; ``into`` gets the source's metrics up to the branch step and its best policy."""
+    """Continue the run at ``path`` in a new directory ``into`` under ``cfg`` (default: the
+    run's config with ``overrides``, ``--set`` texts, then ``explicit`` dotted keys).
+
+    ``cfg`` may differ from the run's config only by a learning-rate decay that starts at or
+    after the run's step (and device, threads, budget, kept policies): the branch is then, to
+    the bit, the run that ``cfg`` trains from scratch, so two recipes can be compared from one
+    shared start. The source is only read; ``into`` gets the source's metrics up to the branch
+    step and its best policy."""
     state_path, state = load_training_state(path)
     step = int(state["counters"]["step"])
     if state.get("curriculum") is not None:
         raise UserError(f"RUN_DIR_OR_CHECKPOINT {state_path}: a curriculum run cannot be branched")
     run_cfg = config_from_dict(state["config"], f"{state_path}: config")
+    if cfg is None:
+        config_source = f"{state_path}: config + --set"
+        cfg = override_config(state["config"], config_source, overrides, **(explicit or {}))
     check_branch_config(run_cfg, cfg, step, config_source)
     into = prepare_new_run_dir(into, "--into")
     with lock_run_dir(into):

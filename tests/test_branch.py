@@ -104,7 +104,9 @@ def test_cli_branch_and_its_one_line_errors(tmp_path, capsys):
     code, _, err = run_cli(["train", "--config", base, "--run-dir", tmp_path / "run"], capsys)
     assert code == 0, err
     code, _, err = run_cli(["resume", tmp_path / "run", "--into", tmp_path / "b"], capsys)
-    assert code == 2 and "--into and --config" in err and len(err.strip().splitlines()) == 1
+    assert code == 2 and "--into: a branch needs" in err and len(err.strip().splitlines()) == 1
+    code, _, err = run_cli(["resume", tmp_path / "run", "--set", "agent.tau=0.5"], capsys)
+    assert code == 2 and "only with --into" in err and len(err.strip().splitlines()) == 1
     data["agent"]["tau"] = 0.5
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.safe_dump(data))
@@ -116,3 +118,22 @@ def test_cli_branch_and_its_one_line_errors(tmp_path, capsys):
     assert code == 0, err
     assert load_checkpoint(tmp_path / "b" / "state.pt")["counters"]["step"] == 300
     assert load_checkpoint(tmp_path / "run" / "state.pt")["counters"]["step"] == 200
+
+
+def test_cli_branch_with_set_alone_starts_from_the_runs_own_config(tmp_path, capsys):
+    import yaml
+
+    from .test_cli import run_cli
+
+    base = tmp_path / "base.yaml"
+    base.write_text(yaml.safe_dump(tiny_dict(total_steps=200)))
+    code, _, err = run_cli(["train", "--config", base, "--run-dir", tmp_path / "run"], capsys)
+    assert code == 0, err
+    sets = ["agent.lr_final=1e-5", "agent.lr_decay_start=200", "agent.lr_decay_end=350"]
+    args = ["resume", tmp_path / "run", "--into", tmp_path / "b", "--steps", 400]
+    code, _, err = run_cli([*args, *(x for s in sets for x in ("--set", s))], capsys)
+    assert code == 0, err
+    train(config_from_dict(decaying(total_steps=400)), tmp_path / "straight")
+    assert_states_equal(trainable_state(tmp_path / "straight"), trainable_state(tmp_path / "b"))
+    code, _, err = run_cli([*args[:3], tmp_path / "c", "--set", "agent.gamma=0.9"], capsys)
+    assert code == 2 and "'agent.gamma' is 0.9" in err
