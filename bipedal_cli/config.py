@@ -124,6 +124,11 @@ class TrainConfig:
     flush_denormal: bool = True
     """Flush denormal floats to zero on CPU: Adam moments of dead units decay into the denormal
     range within a few thousand steps and then slow every update down by up to 2x."""
+    replay_keep_below: float | None = None
+    """FORK's replay curation: an episode's transitions enter the replay buffer only if it fell
+    or its env return is below this (FORK: 250); the others are dropped. None: every episode."""
+    replay_curation_start: int = 0
+    """Policy step from which episodes (those that start there or later) are curated."""
     keep_policies: bool = False
     """Also save the policy of every periodic evaluation, ``policies/step-<N>.pt`` (about 1.4 MB
     each with Hardcore's networks), to choose among them afterwards on seeds that did not pick

@@ -27,6 +27,7 @@ class EpisodeState:
     ret: float = 0.0  # the learner's return (shaped rewards)
     env_ret: float = 0.0  # the env's own return
     env_steps: int = 0  # env steps (action repeat: several per action)
+    curated: bool = False  # its transitions wait for its end, then are kept or dropped
 
 
 @dataclass
@@ -35,11 +36,17 @@ class FinishedEpisode:
     env_ret: float
     env_steps: int
     fell: bool
+    stored: bool = True  # False: replay curation dropped its transitions
 
 
 class EpisodeRunner:
     """Steps the training env (shaping, action repeat, history as configured) and writes each
-    transition to the replay buffer, through an n-step accumulator when ``agent.n_step`` > 1."""
+    transition to the replay buffer, through an n-step accumulator when ``agent.n_step`` > 1.
+
+    A curated episode (``train.replay_keep_below``, FORK's replay curation) holds its
+    transitions until it ends, then writes them only if it fell or its env return is below the
+    threshold: the buffer fills with the episodes that went wrong.
+    """
 
     def __init__(self, cfg: Config, buffer: ReplayBuffer) -> None:
         self.cfg, self.buffer = cfg, buffer
@@ -48,6 +55,7 @@ class EpisodeRunner:
         self.env = self._make_env()
         self.episode = EpisodeState()
         self.obs: np.ndarray | None = None  # None: no episode in progress
+        self.staged: list[tuple] = []  # a curated episode's transitions so far
 
     def _make_env(self):
         a, t = self.cfg.agent, self.cfg.train
@@ -63,12 +71,13 @@ class EpisodeRunner:
         self.env.close()
         self.env = self._make_env()  # follows cfg.env, which a curriculum switches
 
-    def start(self, seed: int) -> None:
+    def start(self, seed: int, curated: bool = False) -> None:
         """A new episode on a new env reset with ``seed``."""
         self._fresh_env()
         obs, _ = self.env.reset(seed=seed)
         self.obs = obs.astype(np.float32)
-        self.episode = EpisodeState(seed=seed)
+        self.episode = EpisodeState(seed=seed, curated=curated)
+        self.staged = []
         if self.nstep is not None:
             self.nstep.reset()
 
@@ -79,8 +88,13 @@ class EpisodeRunner:
         self._account(action, reward, info)
         self.obs = next_obs.astype(np.float32)
         if terminated or truncated:
-            e = self.episode
-            return FinishedEpisode(e.ret, e.env_ret, e.env_steps, bool(info["fell"]))
+            e, fell = self.episode, bool(info["fell"])
+            stored = not e.curated or fell or e.env_ret < self.cfg.train.replay_keep_below
+            if e.curated and stored:
+                for transition in self.staged:
+                    self.buffer.add(*transition)
+            self.staged = []
+            return FinishedEpisode(e.ret, e.env_ret, e.env_steps, fell, stored)
         return None
 
     def _account(self, action: np.ndarray, reward: float, info: dict) -> None:
@@ -92,18 +106,31 @@ class EpisodeRunner:
 
     def _store(self, action, reward, next_obs, terminated: bool, truncated: bool) -> None:
         if self.nstep is None:  # terminated, never truncated: a truncation bootstraps
-            self.buffer.add(self.obs, action, reward, next_obs, terminated)
+            ready = [(self.obs, action, reward, next_obs, terminated)]
+        else:
+            pushed = self.nstep.push(self.obs, action, reward, next_obs, terminated, truncated)
+            ready = [
+                (tr.obs, tr.action, tr.reward, tr.next_obs, tr.terminated, tr.discount)
+                for tr in pushed
+            ]
+        if self.episode.curated:
+            self.staged.extend(ready)
             return
-        for tr in self.nstep.push(self.obs, action, reward, next_obs, terminated, truncated):
-            self.buffer.add(tr.obs, tr.action, tr.reward, tr.next_obs, tr.terminated, tr.discount)
+        for transition in ready:
+            self.buffer.add(*transition)
 
-    def replay(self, seed: int, actions: np.ndarray, expected_obs: np.ndarray) -> bool:
-        """Rebuild an interrupted episode (its transitions are in the buffer already);
-        False when the rebuilt observation differs from ``expected_obs``."""
-        self.start(seed)
+    def replay(
+        self, seed: int, actions: np.ndarray, expected_obs: np.ndarray, curated: bool = False
+    ) -> bool:
+        """Rebuild an interrupted episode (its transitions are in the buffer already, or, when
+        curated, staged again); False when the rebuilt observation differs from
+        ``expected_obs``."""
+        self.start(seed, curated)
         for action in actions:
             next_obs, reward, terminated, truncated, info = self.env.step(action)
-            if self.nstep is not None:  # the pending steps only; what it returns is stored
+            if curated:
+                self._store(action, reward, next_obs, terminated, truncated)
+            elif self.nstep is not None:  # the pending steps only; what it returns is stored
                 self.nstep.push(self.obs, action, reward, next_obs, terminated, truncated)
             self._account(action, reward, info)
             self.obs = next_obs.astype(np.float32)
@@ -117,5 +144,6 @@ class EpisodeRunner:
             "seed": e.seed,
             "actions": torch.from_numpy(np.array(e.actions, np.float32).reshape(-1, act_dim)),
             "ret": e.ret,  # rebuilt by replay; kept as older versions read it
+            "curated": e.curated,
             "obs": None if self.obs is None else torch.from_numpy(self.obs.copy()),
         }

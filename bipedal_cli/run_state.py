@@ -83,7 +83,9 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
     trainer._update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
     ep = state["episode"]
     if ep["obs"] is not None:
-        rebuilt = trainer.runner.replay(int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy())
+        rebuilt = trainer.runner.replay(
+            int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy(), bool(ep.get("curated"))
+        )
         if not rebuilt:
             trainer.reporter.log(
                 "warning: the replayed episode differs from the checkpoint's; the resumed "

@@ -271,7 +271,9 @@ class Trainer:
         self._start_episode()
 
     def _start_episode(self) -> None:
-        self.runner.start(int(self.rng.integers(2**31 - 1)))
+        t = self.cfg.train
+        curated = t.replay_keep_below is not None and self.step >= t.replay_curation_start
+        self.runner.start(int(self.rng.integers(2**31 - 1)), curated)
 
     def _env_step(self, metrics: MetricsWriter, wall_base: float, session_start: float) -> None:
         if self.step < self.cfg.train.warmup_steps:

@@ -83,6 +83,7 @@ def validate(cfg: Any, source: str) -> None:
         (a.n_step >= 1, "agent.n_step", "a positive integer"),
         (a.lr_final is None or a.lr_final >= 0, "agent.lr_final", "null or a number >= 0"),
         (a.lr_decay_start >= 0, "agent.lr_decay_start", "a non-negative integer"),
+        (t.replay_curation_start >= 0, "train.replay_curation_start", "a non-negative integer"),
         (
             a.lr_final is None or a.lr_decay_end > a.lr_decay_start,
             "agent.lr_decay_end",
@@ -135,7 +136,21 @@ def validate(cfg: Any, source: str) -> None:
 
 
 BRANCH_MAY_CHANGE = ("device", "train.threads", "train.total_steps", "train.keep_policies")
-LR_DECAY_KEYS = ("agent.lr_final", "agent.lr_decay_start", "agent.lr_decay_end")
+# Features that start at a policy step: (their keys, the key of that step, is-on, its step).
+DEFERRED = (
+    (
+        ("agent.lr_final", "agent.lr_decay_start", "agent.lr_decay_end"),
+        "agent.lr_decay_start",
+        lambda c: c.agent.lr_final is not None,
+        lambda c: c.agent.lr_decay_start,
+    ),
+    (
+        ("train.replay_keep_below", "train.replay_curation_start"),
+        "train.replay_curation_start",
+        lambda c: c.train.replay_keep_below is not None,
+        lambda c: c.train.replay_curation_start,
+    ),
+)
 
 
 def _flat(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -148,30 +163,29 @@ def _flat(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
-def _lr_constant_until(agent: Any, step: int) -> bool:
-    return agent.lr_final is None or agent.lr_decay_start >= step
-
-
 def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> None:
     """A branch of a run at ``step`` (``bipedal resume RUN --into DIR --config NEW``) must be the
     run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
-    threads, budget and kept policies (they do not change the bits), and a learning-rate decay
-    that changes nothing before ``step``. One line naming the first key that breaks this."""
+    threads, budget and kept policies (they do not change the bits), and features that start
+    at a policy step (a learning-rate decay, replay curation) as long as they change nothing
+    before ``step``. One line naming the first key that breaks this."""
     old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
-    same_decay = all(old[k] == new[k] for k in LR_DECAY_KEYS)
-    both_constant = _lr_constant_until(run_cfg.agent, step) and _lr_constant_until(
-        new_cfg.agent, step
-    )
-    if not (same_decay or both_constant):
-        raise UserError(
-            f"{source}: key 'agent.lr_decay_start' expects a step at or after the branch point "
-            f"{step:,} (the run's learning rate up to there must stay as it was)"
-        )
+    deferred_keys: set[str] = set()
+    for keys, start_key, is_on, start in DEFERRED:
+        deferred_keys.update(keys)
+        if all(old[k] == new[k] for k in keys):
+            continue
+        if any(is_on(c) and start(c) < step for c in (run_cfg, new_cfg)):
+            raise UserError(
+                f"{source}: key {start_key!r} expects a step at or after the branch point "
+                f"{step:,} (the run up to there must stay as it was)"
+            )
     for key, value in new.items():
-        if key in BRANCH_MAY_CHANGE or key in LR_DECAY_KEYS or old.get(key) == value:
+        if key in BRANCH_MAY_CHANGE or key in deferred_keys or old.get(key) == value:
             continue
         raise UserError(
             f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
-            "change only device, train.threads, train.total_steps, train.keep_policies and a "
-            "learning-rate decay that starts at or after the branch point"
+            "change only device, train.threads, train.total_steps, train.keep_policies and "
+            "features that start at or after the branch point (learning-rate decay, replay "
+            "curation)"
         )

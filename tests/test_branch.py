@@ -72,6 +72,7 @@ def test_branch_equals_the_run_its_config_trains_from_scratch(tmp_path):
         ({"agent": {"gamma": 0.99}}, "agent.gamma"),
         ({"agent": {"lr_decay_start": 100}}, "agent.lr_decay_start"),
         ({"train": {"buffer_size": 300}}, "train.buffer_size"),
+        ({"train": {"replay_keep_below": 250.0}}, "train.replay_curation_start"),
     ],
 )
 def test_branch_refuses_a_config_that_changes_the_past(tmp_path, change, key):
@@ -137,3 +138,11 @@ def test_cli_branch_with_set_alone_starts_from_the_runs_own_config(tmp_path, cap
     assert_states_equal(trainable_state(tmp_path / "straight"), trainable_state(tmp_path / "b"))
     code, _, err = run_cli([*args[:3], tmp_path / "c", "--set", "agent.gamma=0.9"], capsys)
     assert code == 2 and "'agent.gamma' is 0.9" in err
+
+
+def test_branch_may_start_replay_curation_at_its_step(tmp_path):
+    train(config_from_dict(tiny_dict(total_steps=200)), tmp_path / "run")
+    data = tiny_dict(total_steps=260)
+    data["train"].update(replay_keep_below=250.0, replay_curation_start=200)
+    result = branch(tmp_path / "run", tmp_path / "branch", config_from_dict(data))
+    assert result.steps == 260
