@@ -19,7 +19,10 @@ from .validation import check_count, check_seeds
 
 
 def select(
-    runs: Annotated[list[Path], typer.Argument(metavar="RUN_DIR...", help="Run directories.")],
+    runs: Annotated[
+        list[Path],
+        typer.Argument(metavar="RUN_DIR...", help="Run directories (or policy files)."),
+    ],
     top: Annotated[
         int, typer.Option("--top", help="Candidates: the best K by periodic evaluation.")
     ] = 5,

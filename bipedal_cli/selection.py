@@ -36,10 +36,11 @@ def describe(path: Path) -> Candidate:
     step = int(meta["steps"])
     last = meta.get("last_eval") or {}
     at_step = last.get("step") == step
+    in_run = path.name in (BEST_POLICY_FILE, POLICY_FILE) or path.parent.name == POLICIES_DIR
     run = path.parent.parent if path.parent.name == POLICIES_DIR else path.parent
     return Candidate(
         path,
-        run.name,
+        run.name if in_run else path.name,
         step,
         meta["env"],
         float(last["mean"]) if at_step else None,
@@ -48,9 +49,12 @@ def describe(path: Path) -> Candidate:
 
 
 def run_candidates(run_dir: Path) -> list[Candidate]:
-    """The kept policies, ``best_policy.pt`` and ``policy.pt`` of a run, one per step."""
+    """The kept policies, ``best_policy.pt`` and ``policy.pt`` of a run, one per step; a policy
+    file given instead of a run (a shipped policy to compare against) is one candidate."""
+    if run_dir.is_file():
+        return [describe(run_dir)]
     if not run_dir.is_dir():
-        raise UserError(f"RUN_DIR {run_dir}: not a run directory")
+        raise UserError(f"RUN_DIR {run_dir}: not a run directory or a policy file")
     paths = sorted((run_dir / POLICIES_DIR).glob("step-*.pt"))
     paths += [p for p in (run_dir / BEST_POLICY_FILE, run_dir / POLICY_FILE) if p.is_file()]
     if not paths:

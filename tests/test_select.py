@@ -43,6 +43,10 @@ def test_run_candidates_are_one_per_step_with_their_own_evaluation(kept_run):
     pool = distinct(found + run_candidates(branch))
     assert sorted(c.step for c in pool) == [100, 200, 300]
     assert all(c.run == "run" for c in pool)
+    shipped = kept_run.parent / "shipped.pt"  # a policy file: one candidate, named by its file
+    shipped.write_bytes((kept_run / "policies" / "step-200.pt").read_bytes())
+    (only,) = run_candidates(shipped)
+    assert (only.run, only.step, only.periodic is not None) == ("shipped.pt", 200, True)
     with pytest.raises(UserError, match="not a run directory"):
         run_candidates(kept_run / "missing")
 
