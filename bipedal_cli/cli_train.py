@@ -54,7 +54,7 @@ def train(
         list[str] | None,
         typer.Option("--set", help="Override a config key, e.g. --set agent.lr=3e-4 (repeatable)."),
     ] = None,
-    steps: Annotated[int | None, typer.Option("--steps", help="Total env steps.")] = None,
+    steps: Annotated[int | None, typer.Option("--steps", help="Total policy steps (env steps / action repeat).")] = None,
     seed: Annotated[int | None, typer.Option("--seed", help="Random seed.")] = None,
     run_dir: Annotated[
         Path | None,
@@ -98,7 +98,7 @@ def resume(
         Path, typer.Argument(metavar="RUN_DIR_OR_CHECKPOINT", help="Run directory or its state.pt.")
     ],
     steps: Annotated[
-        int | None, typer.Option("--steps", help="Train until this many env steps in all.")
+        int | None, typer.Option("--steps", help="Train until this many policy steps in all.")
     ] = None,
     until_solved: Annotated[bool, typer.Option("--until-solved")] = False,
     device: DeviceOpt = None,

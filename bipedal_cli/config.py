@@ -97,7 +97,8 @@ class TrainConfig:
     """The training loop: budget, warm-up, evaluation and checkpoint cadence."""
 
     total_steps: int = 300_000
-    """Env steps to train for (``--steps`` overrides)."""
+    """Policy steps to train for (``--steps`` overrides); each is ``agent.action_repeat`` env
+    steps, so without action repeat these are env steps."""
     warmup_steps: int = 1000
     """Random-action steps before learning starts (Table 1's 'learning starts')."""
     buffer_size: int = 1_000_000
@@ -105,7 +106,7 @@ class TrainConfig:
     updates_per_step: int = 1
     """Gradient steps per env step after warm-up (UTD ratio)."""
     eval_every: int = 5_000
-    """Env steps between periodic deterministic evaluations (0: never)."""
+    """Policy steps between periodic deterministic evaluations (0: never)."""
     eval_episodes: int = 5
     """Episodes per periodic evaluation."""
     solved_episodes: int = 100
@@ -113,7 +114,7 @@ class TrainConfig:
     solved_threshold: float = 300.0
     """Mean return above which the environment counts as solved."""
     checkpoint_every: int = 10_000
-    """Env steps between training-state checkpoints."""
+    """Policy steps between training-state checkpoints."""
     threads: int = 0
     """CPU threads for training; 0 means all cores. With 2 or more (on CPU, with
     ``split_update``) each update runs its critics' and actor's parts on two threads with

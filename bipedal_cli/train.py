@@ -207,7 +207,7 @@ class Trainer:
         )
 
     def _loop(self, metrics: MetricsWriter, total: int, until_solved: bool) -> tuple[str, float]:
-        """Env steps and updates until the budget, a stop request or a solved test."""
+        """Policy steps and updates until the budget, a stop request or a solved test."""
         cfg, t = self.cfg, self.cfg.train
         self.reporter.start(self.step, total)
         stopped = "budget"
