@@ -54,7 +54,9 @@ def train(
         list[str] | None,
         typer.Option("--set", help="Override a config key, e.g. --set agent.lr=3e-4 (repeatable)."),
     ] = None,
-    steps: Annotated[int | None, typer.Option("--steps", help="Total policy steps (env steps / action repeat).")] = None,
+    steps: Annotated[
+        int | None, typer.Option("--steps", help="Total policy steps (env steps / action repeat).")
+    ] = None,
     seed: Annotated[int | None, typer.Option("--seed", help="Random seed.")] = None,
     run_dir: Annotated[
         Path | None,

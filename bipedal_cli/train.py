@@ -4,9 +4,10 @@ A run lives in one directory (:mod:`bipedal_cli.rundir`): ``config.yaml``, ``met
 ``state.pt`` (everything an exact resume needs) and ``policy.pt`` (the actor alone).
 
 Exact resume (:mod:`bipedal_cli.run_state`): every source of randomness is checkpointed, and an
-episode cut by a checkpoint is rebuilt by replaying it.
+episode cut by a checkpoint is rebuilt by replaying it. Periodic evaluations, best and kept
+policies and the 100-episode test: :mod:`bipedal_cli.periodic_eval`.
 
-``step`` counts policy steps: transitions stored, and updates. With ``agent.action_repeat`` = k
+``step`` counts policy steps: transitions stored (replay curation may drop some), and updates. With ``agent.action_repeat`` = k
 each is k env steps (fewer at an episode's end); ``env_steps`` counts those.
 """
 
@@ -26,21 +27,18 @@ import torch
 from .agent import TQCAgent
 from .buffer import ReplayBuffer
 from .checkpoint import (
-    BEST_POLICY_FILE,
-    POLICIES_DIR,
     POLICY_FILE,
     STATE_FILE,
     atomic_save,
     policy_payload,
-    recorded_evaluation,
 )
 from .config import Config
 from .devices import configure_threads, resolve_device
 from .envs import policy_dims
 from .episodes import EpisodeRunner, FinishedEpisode
 from .errors import UserError
-from .evaluation import actor_policy, evaluate_actor, run_episodes, summarize
 from .metrics import METRICS_FILE, MetricsWriter
+from .periodic_eval import evaluate_on_eval_seeds, periodic_evaluation
 from .reporting import NullReporter, Reporter
 from .run_state import restore_run_state, run_state
 from .rundir import (
@@ -151,22 +149,9 @@ class Trainer:
         )
         atomic_save(payload, path)
 
-    # ------------------------------------------------------------ evaluation
     def evaluate(self, episodes: int) -> dict:
-        seeds = [self.cfg.train.eval_seed + i for i in range(episodes)]
-        policy = actor_policy(self.agent.actor, self.device)
-        return summarize(
-            run_episodes(policy, self.cfg.env, seeds, self.cfg.agent),
-            self.cfg.train.solved_threshold,
-        )
-
-    def full_evaluation(self) -> dict:
-        t = self.cfg.train
-        seeds = [t.eval_seed + i for i in range(t.solved_episodes)]
-        results = evaluate_actor(self.agent.actor, self.cfg.agent, self.cfg.env, seeds)
-        summary = summarize(results, t.solved_threshold)
-        summary["seeds"] = [seeds[0], seeds[-1]]
-        return summary
+        """``episodes`` deterministic episodes on the periodic evaluations' seeds."""
+        return evaluate_on_eval_seeds(self, episodes)
 
     # ------------------------------------------------------------------ loop
     def request_stop(self, signum: int = signal.SIGINT) -> None:
@@ -234,7 +219,7 @@ class Trainer:
                         self._update_metrics = self.agent.update(batch)
                 self.wall_time = wall_base + time.perf_counter() - session_start
                 if t.eval_every and self.step % t.eval_every == 0:
-                    outcome = self._evaluate(metrics, until_solved)
+                    outcome = periodic_evaluation(self, metrics, until_solved)
                     if outcome is not None:
                         stopped = outcome
                         break
@@ -302,7 +287,7 @@ class Trainer:
             "shaped_return": ep.ret,
             "length": ep.env_steps,
             "fell": ep.fell,
-            **self._common(),
+            **self.row_counters(),
             **self._loss_metrics(),
         }
         metrics.write(row)
@@ -317,7 +302,7 @@ class Trainer:
         }
         return self.last_metrics
 
-    def _common(self) -> dict[str, Any]:
+    def row_counters(self) -> dict[str, Any]:
         return {
             "stage": self.cfg.env,
             "step": self.step,
@@ -325,55 +310,6 @@ class Trainer:
             "episode": self.episodes,
             "wall_time": round(self.wall_time, 2),
         }
-
-    def _eval_row(self, kind: str, summary: dict) -> dict[str, Any]:
-        return {
-            "kind": kind,
-            "return": summary["mean"],
-            "return_std": summary["std"],
-            "length": summary["mean_length"],
-            "fell": summary["falls"],
-            **self._common(),
-        }
-
-    def _evaluate(self, metrics: MetricsWriter, until_solved: bool) -> str | None:
-        """The periodic evaluation; with ``until_solved``, the full test once it passes the
-        threshold. Then :attr:`on_evaluation`, after every evaluation. Returns "solved" when
-        the full test says so, else "pruned" when :attr:`on_evaluation` asks to stop, else None."""
-        t = self.cfg.train
-        self.reporter.update({**self.snapshot(0.0), "phase": "evaluating"})
-        self.last_eval = self.evaluate(t.eval_episodes)
-        self.last_eval["step"] = self.step
-        metrics.write(self._eval_row("eval", self.last_eval))
-        best = recorded_evaluation(self.run_dir / BEST_POLICY_FILE, self.cfg.env)
-        if best is None or self.last_eval["mean"] > best:
-            self.save_policy(self.run_dir / BEST_POLICY_FILE)
-        if t.keep_policies:
-            (self.run_dir / POLICIES_DIR).mkdir(exist_ok=True)
-            self.save_policy(self.run_dir / POLICIES_DIR / f"step-{self.step}.pt")
-        solved = False
-        if until_solved and self.last_eval["mean"] > t.solved_threshold:
-            solved = self._full_test(metrics)
-        stop = self.on_evaluation is not None and self.on_evaluation(self)
-        if solved:
-            return "solved"
-        return "pruned" if stop else None
-
-    def _full_test(self, metrics: MetricsWriter) -> bool:
-        """The ``solved_episodes`` test (100 episodes): True when it passes."""
-        t = self.cfg.train
-        self.reporter.log(
-            f"step {self.step}: evaluation {self.last_eval['mean']:.1f} > "
-            f"{t.solved_threshold:g}; running the {t.solved_episodes}-episode test"
-        )
-        self.full_eval = self.full_evaluation()
-        self.full_eval["step"] = self.step
-        metrics.write(self._eval_row("full_eval", self.full_eval))
-        self.reporter.log(
-            f"{t.solved_episodes}-episode evaluation: "
-            f"{self.full_eval['mean']:.1f} +- {self.full_eval['std']:.1f}"
-        )
-        return bool(self.full_eval["solved"])
 
     def snapshot(self, steps_per_s: float) -> dict[str, Any]:
         recent = list(self.recent_returns)
