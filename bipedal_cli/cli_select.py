@@ -39,8 +39,9 @@ def select(
     force: Annotated[bool, typer.Option("--force", help="Overwrite --out / --json.")] = False,
     workers: Annotated[int, typer.Option("--workers", help="Processes (0: every core).")] = 0,
 ) -> None:
-    """Choose among runs' policies: the top K by periodic evaluation, re-evaluated on held-out
-    seeds; the best there is the choice (its `bipedal eval` is then a clean estimate)."""
+    """Choose among runs' policies: the top K by periodic evaluation (and every policy file
+    named), re-evaluated on held-out seeds; the best there is the choice (its `bipedal eval`
+    is then a clean estimate)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     from .checkpoint import actor_from_checkpoint, load_checkpoint
@@ -54,11 +55,14 @@ def select(
     for path, option in ((out, "--out"), (json_out, "--json")):
         if path is not None:
             check_output_path(path, option, force=force)
-    pool = distinct([c for run in runs for c in run_candidates(run)])
+    named = [c for path in runs if path.is_file() for c in run_candidates(path)]
+    found = [c for path in runs if not path.is_file() for c in run_candidates(path)]
+    pool = distinct(named + found)
     envs = {c.env for c in pool}
     if len(envs) > 1:
         raise UserError(f"RUN_DIR: the runs' policies are for different envs: {sorted(envs)}")
-    chosen = top_candidates(pool, top)
+    # a policy file named on the command line is always a candidate; runs give their top K
+    chosen = pool[: len(named)] + top_candidates(pool[len(named) :], top)
     seeds = list(range(seed, seed + episodes))
     scores = []
     with Progress(

@@ -7,8 +7,9 @@ Exact resume (:mod:`bipedal_cli.run_state`): every source of randomness is check
 episode cut by a checkpoint is rebuilt by replaying it. Periodic evaluations, best and kept
 policies and the 100-episode test: :mod:`bipedal_cli.periodic_eval`.
 
-``step`` counts policy steps: transitions stored (replay curation may drop some), and updates. With ``agent.action_repeat`` = k
-each is k env steps (fewer at an episode's end); ``env_steps`` counts those.
+``step`` counts policy steps: transitions stored (replay curation may drop some), and updates.
+With ``agent.action_repeat`` = k each is k env steps (fewer at an episode's end); ``env_steps``
+counts those.
 """
 
 from __future__ import annotations

@@ -65,3 +65,20 @@ def test_select_copies_the_held_out_winner(tmp_path, kept_run, capsys):
     assert "chosen:" in stdout
     code, _, err = run_cli([*args], capsys)  # --out exists now
     assert code == 2 and "--force" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_named_policy_file_is_always_a_candidate(tmp_path, kept_run, capsys):
+    """The incumbent competes even when its periodic evaluation is below the runs' top K."""
+    import torch
+
+    incumbent = tmp_path / "incumbent.pt"
+    data = load_checkpoint(kept_run / "policies" / "step-100.pt")
+    data.pop("path")
+    data["meta"]["last_eval"]["mean"] = -1e9  # ranked last by periodic evaluation
+    torch.save(data, incumbent)
+    report = tmp_path / "select.json"
+    args = ["select", incumbent, kept_run, "--top", 1, "--episodes", 1, "--workers", 1]
+    code, _, err = run_cli([*args, "--json", report], capsys)
+    assert code == 0, err
+    paths = [r["path"] for r in json.loads(report.read_text())["candidates"]]
+    assert paths[0] == str(incumbent) and len(paths) == 2
