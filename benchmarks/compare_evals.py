@@ -1,0 +1,63 @@
+"""Periodic evaluations of runs side by side from a policy step on (branches of one run, say).
+
+    python benchmarks/compare_evals.py docs/runs/hardcore-direct-seed0 \\
+        docs/runs/hardcore-lrdecay-seed0 --from 1100000
+
+Prints one row per evaluation step (each run's mean and falls there), then per run: how many
+evaluations, their mean and median, the best, the mean falls per evaluation, and every
+100-episode test. README and docs/hardcore.md take their A/B figures from it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from bipedal_cli.metrics import METRICS_FILE, read_metrics  # noqa: E402
+
+
+def evaluations(path: Path, first: int, kind: str = "eval") -> dict[int, tuple[float, int]]:
+    rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
+    return {
+        int(r["step"]): (float(r["return"]), int(float(r["fell"])))
+        for r in rows
+        if r["kind"] == kind and int(r["step"]) >= first
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("runs", nargs="+", type=Path)
+    parser.add_argument("--from", dest="first", type=int, default=0, help="first policy step")
+    args = parser.parse_args()
+    names = [p.name for p in args.runs]
+    evals = [evaluations(p, args.first) for p in args.runs]
+    print("| policy step | " + " | ".join(names) + " |")
+    print("|---|" + "---|" * len(names))
+    for step in sorted(set().union(*evals)):
+        cells = [f"{e[step][0]:.1f} ({e[step][1]} falls)" if step in e else "-" for e in evals]
+        print(f"| {step:,} | " + " | ".join(cells) + " |")
+    print()
+    print("| run | evaluations | mean | median | best | falls per evaluation | 100-episode tests |")
+    print("|---|---|---|---|---|---|---|")
+    for path, name, e in zip(args.runs, names, evals, strict=True):
+        if not e:
+            print(f"| {name} | 0 | - | - | - | - | - |")
+            continue
+        means = [m for m, _ in e.values()]
+        best = max(e, key=lambda s: e[s][0])
+        tests = evaluations(path, args.first, "full_eval")
+        test_text = ", ".join(f"{m:.1f} ({f} falls) at {s:,}" for s, (m, f) in tests.items())
+        print(
+            f"| {name} | {len(e)} | {statistics.mean(means):.1f} | "
+            f"{statistics.median(means):.1f} | {e[best][0]:.1f} at {best:,} | "
+            f"{statistics.mean(f for _, f in e.values()):.1f} | {test_text or '-'} |"
+        )
+
+
+if __name__ == "__main__":
+    main()
