@@ -4,8 +4,9 @@
         docs/runs/hardcore-lrdecay-seed0 --from 1100000
 
 Prints one row per evaluation step (each run's mean and falls there), then per run: how many
-evaluations, their mean and median, the best, the mean falls per evaluation, and every
-100-episode test. README and docs/hardcore.md take their A/B figures from it.
+evaluations, their mean and median, the best, the mean falls per evaluation, every 100-episode
+test, and its training episodes after ``--from`` (how many, their mean env return, how many
+fell). README and docs/hardcore.md take their A/B figures from it.
 """
 
 from __future__ import annotations
@@ -29,6 +30,17 @@ def evaluations(path: Path, first: int, kind: str = "eval") -> dict[int, tuple[f
     }
 
 
+def training_episodes(path: Path, first: int) -> tuple[int, float, float]:
+    """Training episodes ending after ``first``: count, mean env return, fraction that fell."""
+    rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
+    mine = [r for r in rows if r["kind"] == "episode" and int(r["step"]) > first]
+    if not mine:
+        return 0, float("nan"), float("nan")
+    returns = [float(r["return"]) for r in mine]
+    falls = [int(float(r["fell"])) for r in mine]
+    return len(mine), statistics.mean(returns), statistics.mean(falls)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("runs", nargs="+", type=Path)
@@ -42,20 +54,25 @@ def main() -> None:
         cells = [f"{e[step][0]:.1f} ({e[step][1]} falls)" if step in e else "-" for e in evals]
         print(f"| {step:,} | " + " | ".join(cells) + " |")
     print()
-    print("| run | evaluations | mean | median | best | falls per evaluation | 100-episode tests |")
-    print("|---|---|---|---|---|---|---|")
+    print(
+        "| run | evaluations | mean | median | best | falls per evaluation | 100-episode tests "
+        "| training episodes: count, mean return, fell |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
     for path, name, e in zip(args.runs, names, evals, strict=True):
         if not e:
-            print(f"| {name} | 0 | - | - | - | - | - |")
+            print(f"| {name} | 0 | - | - | - | - | - | - |")
             continue
         means = [m for m, _ in e.values()]
         best = max(e, key=lambda s: e[s][0])
         tests = evaluations(path, args.first, "full_eval")
+        count, mean_return, fell = training_episodes(path, args.first)
         test_text = ", ".join(f"{m:.1f} ({f} falls) at {s:,}" for s, (m, f) in tests.items())
         print(
             f"| {name} | {len(e)} | {statistics.mean(means):.1f} | "
             f"{statistics.median(means):.1f} | {e[best][0]:.1f} at {best:,} | "
-            f"{statistics.mean(f for _, f in e.values()):.1f} | {test_text or '-'} |"
+            f"{statistics.mean(f for _, f in e.values()):.1f} | {test_text or '-'} | "
+            f"{count:,}, {mean_return:.1f}, {fell:.0%} |"
         )
 
 
