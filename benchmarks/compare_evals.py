@@ -6,7 +6,8 @@
 Prints one row per evaluation step (each run's mean and falls there), then per run: how many
 evaluations, their mean and median, the best, the mean falls per evaluation, every 100-episode
 test, and its training episodes after ``--from`` (how many, their mean env return, how many
-fell). README and docs/hardcore.md take their A/B figures from it.
+fell). First it says whether the runs' metrics agree before ``--from`` (a branch and its
+source must). README and docs/hardcore.md take their A/B figures from it.
 """
 
 from __future__ import annotations
@@ -41,6 +42,20 @@ def training_episodes(path: Path, first: int) -> tuple[int, float, float]:
     return len(mine), statistics.mean(returns), statistics.mean(falls)
 
 
+def shared_rows(paths: list[Path], before: int) -> tuple[int, bool]:
+    """How many metrics rows the runs hold before step ``before``, and whether they are the
+    same in every run (wall times aside): a branch and its source must agree there."""
+    tables = [
+        [
+            tuple(v for k, v in r.items() if k != "wall_time")
+            for r in read_metrics(p if p.is_file() else p / METRICS_FILE)
+            if int(r["step"]) < before
+        ]
+        for p in paths
+    ]
+    return len(tables[0]), all(t == tables[0] for t in tables)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("runs", nargs="+", type=Path)
@@ -53,6 +68,9 @@ def main() -> None:
     for step in sorted(set().union(*evals)):
         cells = [f"{e[step][0]:.1f} ({e[step][1]} falls)" if step in e else "-" for e in evals]
         print(f"| {step:,} | " + " | ".join(cells) + " |")
+    count, same = shared_rows(args.runs, args.first)
+    print(f"\nrows before step {args.first:,}: {count:,} in the first run, ", end="")
+    print("the same in every run" if same else "NOT the same in every run")
     print()
     print(
         "| run | evaluations | mean | median | best | falls per evaluation | 100-episode tests "

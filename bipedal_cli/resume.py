@@ -131,9 +131,10 @@ def branch(
     """Continue the run at ``path`` in a new directory ``into`` under ``cfg`` (default: the
     run's config with ``overrides``, ``--set`` texts, then ``explicit`` dotted keys).
 
-    ``cfg`` may differ from the run's config only by a learning-rate decay that starts at or
-    after the run's step (and device, threads, budget, kept policies): the branch is then, to
-    the bit, the run that ``cfg`` trains from scratch, so two recipes can be compared from one
+    ``cfg`` may differ from the run's config only by features that start at or after the run's
+    step (a learning-rate decay, replay curation) and by device, threads, budget and kept
+    policies (:func:`~bipedal_cli.validation.check_branch_config`): the branch is then, to the
+    bit, the run that ``cfg`` trains from scratch, so two recipes can be compared from one
     shared start. The source is only read; ``into`` gets the source's metrics up to the branch
     step and its best policy."""
     state_path, state = load_training_state(path)
