@@ -24,8 +24,12 @@ def select(
         typer.Argument(metavar="RUN_DIR...", help="Run directories (or policy files)."),
     ],
     top: Annotated[
-        int, typer.Option("--top", help="Candidates: the best K by periodic evaluation.")
+        int,
+        typer.Option("--top", help="Candidates: the best K by periodic evaluation (0: all)."),
     ] = 5,
+    since: Annotated[
+        int, typer.Option("--since", help="Only the runs' policies from policy step S on.")
+    ] = 0,
     episodes: Annotated[int, typer.Option("--episodes", help="Held-out episodes each.")] = 100,
     seed: Annotated[
         int, typer.Option("--seed", help="Held-out env seeds S.. (not eval's 0-99).")
@@ -39,15 +43,17 @@ def select(
     force: Annotated[bool, typer.Option("--force", help="Overwrite --out / --json.")] = False,
     workers: Annotated[int, typer.Option("--workers", help="Processes (0: every core).")] = 0,
 ) -> None:
-    """Choose among runs' policies: the top K by periodic evaluation (and every policy file
-    named), re-evaluated on held-out seeds; the best there is the choice (its `bipedal eval`
-    is then a clean estimate)."""
+    """Choose among runs' policies: the top K by periodic evaluation from step S on (and every
+    policy file named), re-evaluated on held-out seeds; the best there is the choice (its
+    `bipedal eval` is then a clean estimate)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     from .checkpoint import actor_from_checkpoint, load_checkpoint
     from .evaluation import evaluate_actor, summarize
 
-    check_count("--top", top)
+    check_count("--top", top, low=0)
+    if since < 0:
+        raise UserError(f"--since {since}: expected a non-negative policy step")
     check_count("--episodes", episodes)
     check_seeds("--seed", seed, episodes)
     if workers < 0:
@@ -57,12 +63,12 @@ def select(
             check_output_path(path, option, force=force)
     named = [c for path in runs if path.is_file() for c in run_candidates(path)]
     found = [c for path in runs if not path.is_file() for c in run_candidates(path)]
-    pool = distinct(named + found)
+    pool = distinct(named + [c for c in found if c.step >= since])
     envs = {c.env for c in pool}
     if len(envs) > 1:
         raise UserError(f"RUN_DIR: the runs' policies are for different envs: {sorted(envs)}")
     # a policy file named on the command line is always a candidate; runs give their top K
-    chosen = pool[: len(named)] + top_candidates(pool[len(named) :], top)
+    chosen = pool[: len(named)] + top_candidates(pool[len(named) :], top or len(pool))
     seeds = list(range(seed, seed + episodes))
     scores = []
     with Progress(

@@ -133,7 +133,7 @@ class TrainConfig:
     keep_policies: bool = False
     """Also save the policy of every periodic evaluation, ``policies/step-<N>.pt`` (about 1.4 MB
     each with Hardcore's networks), to choose among them afterwards on seeds that did not pick
-    them (``benchmarks/select_policy.py``). Changes nothing in training."""
+    them (``bipedal select``). Changes nothing in training."""
     eval_seed: int = 1_000_000
     """First env seed of evaluation episodes (kept apart from training seeds)."""
     fall_penalty: float | None = None

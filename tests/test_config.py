@@ -21,6 +21,7 @@ SHIPPED = {
     "hardcore": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-curriculum": ("BipedalWalker-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-h8-curated": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
 }
 
 
@@ -48,6 +49,21 @@ def test_hardcore_lrdecay_is_hardcore_until_its_decay_starts():
     check_branch_config(base, decay, 1_092_168, "hardcore-lrdecay.yaml")
     with pytest.raises(UserError, match="lr_decay_start"):
         check_branch_config(base, decay, 1_100_001, "hardcore-lrdecay.yaml")
+
+
+def test_hardcore_h8_curated_is_lrdecay_with_history_8_and_fork_curation():
+    """Its comparison from step 0 is hardcore-lrdecay.yaml's run: nothing else may differ."""
+    decay, h8 = (
+        resolve_config(CONFIGS / f"{n}.yaml") for n in ("hardcore-lrdecay", "hardcore-h8-curated")
+    )
+    assert (h8.agent.history, h8.train.replay_keep_below, h8.train.replay_curation_start) == (
+        8,
+        250.0,
+        0,
+    )
+    assert h8.train.keep_policies
+    h8.agent.history, h8.train.replay_keep_below, h8.train.keep_policies = 4, None, False
+    assert h8 == decay
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():

@@ -82,3 +82,14 @@ def test_a_named_policy_file_is_always_a_candidate(tmp_path, kept_run, capsys):
     assert code == 0, err
     paths = [r["path"] for r in json.loads(report.read_text())["candidates"]]
     assert paths[0] == str(incumbent) and len(paths) == 2
+
+
+def test_top_zero_takes_every_policy_from_since_on(tmp_path, kept_run, capsys):
+    report = tmp_path / "select.json"
+    args = ["select", kept_run, "--top", 0, "--since", 200, "--episodes", 1, "--workers", 1]
+    code, _, err = run_cli([*args, "--json", report], capsys)
+    assert code == 0, err
+    steps = sorted(r["step"] for r in json.loads(report.read_text())["candidates"])
+    assert steps == [200, 300]
+    code, _, err = run_cli(["select", kept_run, "--since", -1], capsys)
+    assert code == 2 and "--since" in err and len(err.strip().splitlines()) == 1
