@@ -14,7 +14,7 @@ from rich.table import Table
 from .cli_common import console
 from .errors import UserError
 from .paths import atomic_path, check_output_path, printable
-from .selection import HELD_OUT_SEED, distinct, run_candidates, top_candidates
+from .selection import HELD_OUT_SEED, distinct, finalists, run_candidates, top_candidates
 from .validation import check_count, check_seeds
 
 
@@ -41,21 +41,24 @@ def select(
         Path | None, typer.Option("--json", help="Write every candidate's scores.")
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite --out / --json.")] = False,
+    confirm: Annotated[
+        int,
+        typer.Option(
+            "--confirm",
+            help="Then N more seeds for the winner against the incumbent (or the runner-up).",
+        ),
+    ] = 0,
     workers: Annotated[int, typer.Option("--workers", help="Processes (0: every core).")] = 0,
 ) -> None:
     """Choose among runs' policies: the top K by periodic evaluation from step S on (and every
     policy file named), re-evaluated on held-out seeds; the best there is the choice (its
     `bipedal eval` is then a clean estimate)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
-
-    from .checkpoint import actor_from_checkpoint, load_checkpoint
-    from .evaluation import evaluate_actor, summarize
-
     check_count("--top", top, low=0)
     if since < 0:
         raise UserError(f"--since {since}: expected a non-negative policy step")
     check_count("--episodes", episodes)
-    check_seeds("--seed", seed, episodes)
+    check_count("--confirm", confirm, low=0)
+    check_seeds("--seed", seed, episodes + confirm)
     if workers < 0:
         raise UserError("--workers: expected 0 (every core) or a positive integer")
     for path, option in ((out, "--out"), (json_out, "--json")):
@@ -70,12 +73,47 @@ def select(
     # a policy file named on the command line is always a candidate; runs give their top K
     chosen = pool[: len(named)] + top_candidates(pool[len(named) :], top or len(pool))
     seeds = list(range(seed, seed + episodes))
+    scores = _evaluate(chosen, seeds, workers)
+    best = max(range(len(chosen)), key=lambda i: scores[i]["mean"])
+    console.print(_table(chosen, scores, best, seeds))
+    payload: dict = {"seeds": [seeds[0], seeds[-1]]}
+    if confirm:
+        final = [chosen[i] for i in finalists([s["mean"] for s in scores], len(named))]
+        second = list(range(seeds[-1] + 1, seeds[-1] + 1 + confirm))
+        final_scores = _evaluate(final, second, workers)
+        pick = max(range(len(final)), key=lambda i: final_scores[i]["mean"])
+        console.print(_table(final, final_scores, pick, second, "confirmation"))
+        payload["confirm"] = {
+            "seeds": [second[0], second[-1]],
+            "finalists": _rows(final, final_scores),
+        }
+        winner = final[pick]
+    else:
+        winner = chosen[best]
+    console.print(f"chosen: {printable(winner.path)} (step {winner.step:,})")
+    if out is not None:
+        with atomic_path(out) as tmp:
+            shutil.copyfile(winner.path, tmp)
+        console.print(f"copied to {printable(out)}; report its score with `bipedal eval {out}`")
+    if json_out is not None:
+        payload.update(chosen=str(winner.path), candidates=_rows(chosen, scores))
+        with atomic_path(json_out) as tmp:
+            tmp.write_text(json.dumps(payload, indent=1))
+
+
+def _evaluate(candidates, seeds: list[int], workers: int) -> list[dict]:
+    """Each candidate's summary over one episode per seed, under one progress bar."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    from .checkpoint import actor_from_checkpoint, load_checkpoint
+    from .evaluation import evaluate_actor, summarize
+
     scores = []
     with Progress(
         "[bold]held-out", BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console
     ) as progress:
-        task = progress.add_task("select", total=len(chosen) * episodes)
-        for c in chosen:
+        task = progress.add_task("select", total=len(candidates) * len(seeds))
+        for c in candidates:
             actor, cfg = actor_from_checkpoint(load_checkpoint(c.path))
             results = evaluate_actor(
                 actor,
@@ -86,28 +124,20 @@ def select(
                 on_episodes=lambda n: progress.advance(task, n),
             )
             scores.append(summarize(results, cfg.train.solved_threshold))
-    best = max(range(len(chosen)), key=lambda i: scores[i]["mean"])
-    console.print(_table(chosen, scores, best, seeds))
-    winner = chosen[best]
-    console.print(f"chosen: {printable(winner.path)} (step {winner.step:,})")
-    if out is not None:
-        with atomic_path(out) as tmp:
-            shutil.copyfile(winner.path, tmp)
-        console.print(f"copied to {printable(out)}; report its score with `bipedal eval {out}`")
-    if json_out is not None:
-        rows = [
-            {"path": str(c.path), "step": c.step, "periodic": c.periodic, "held_out": s}
-            for c, s in zip(chosen, scores, strict=True)
-        ]
-        payload = {"seeds": [seeds[0], seeds[-1]], "chosen": str(winner.path), "candidates": rows}
-        with atomic_path(json_out) as tmp:
-            tmp.write_text(json.dumps(payload, indent=1))
+    return scores
 
 
-def _table(chosen, scores, best: int, seeds: list[int]) -> Table:
+def _rows(candidates, scores) -> list[dict]:
+    return [
+        {"path": str(c.path), "step": c.step, "periodic": c.periodic, "held_out": s}
+        for c, s in zip(candidates, scores, strict=True)
+    ]
+
+
+def _table(chosen, scores, best: int, seeds: list[int], title: str = "held-out") -> Table:
     from .display import falls_text
 
-    table = Table(title=f"held-out env seeds {seeds[0]}..{seeds[-1]}")
+    table = Table(title=f"{title}: env seeds {seeds[0]}..{seeds[-1]}")
     for col in ("", "run", "step", "periodic", "held-out mean", "std", "median", "falls"):
         table.add_column(col, justify="right")
     for i, (c, s) in enumerate(zip(chosen, scores, strict=True)):

@@ -6,6 +6,12 @@ many noisy 20-episode means is biased upward (the winner's curse), and choosing 
 ``bipedal eval``'s seeds 0-99 would bias the reported score the same way. So the top few are
 evaluated again on held-out seeds (2,000,000 on by default) and the best there is the choice;
 its ``bipedal eval`` on seeds 0-99 is then a clean estimate.
+
+The best of many on 100 held-out episodes is itself the best of many noisy means: with K
+candidates whose true scores are close, the round's winner leads by luck about as often as by
+merit. ``--confirm N`` adds a second round on the next N seeds between two finalists only (the
+round's winner and the incumbent, the first policy file named, or else the runner-up); two
+candidates leave almost no room for the winner's curse.
 """
 
 from __future__ import annotations
@@ -87,3 +93,12 @@ def top_candidates(candidates: list[Candidate], k: int) -> list[Candidate]:
         return (c.periodic is not None, c.periodic or 0.0, c.step)
 
     return sorted(candidates, key=key, reverse=True)[:k]
+
+
+def finalists(means: list[float], named: int) -> list[int]:
+    """The confirmation round's candidates, as indices into the first round's: its winner and
+    the incumbent (index 0, when policy files were named), or else the runner-up. One index
+    when the winner is the incumbent or there is no other candidate."""
+    ranked = sorted(range(len(means)), key=lambda i: means[i], reverse=True)
+    other = 0 if named else (ranked[1] if len(ranked) > 1 else ranked[0])
+    return [ranked[0]] if other == ranked[0] else [ranked[0], other]

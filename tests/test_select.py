@@ -8,7 +8,7 @@ import pytest
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict
 from bipedal_cli.errors import UserError
-from bipedal_cli.selection import Candidate, distinct, run_candidates, top_candidates
+from bipedal_cli.selection import Candidate, distinct, finalists, run_candidates, top_candidates
 from bipedal_cli.train import train
 
 from .conftest import tiny_dict
@@ -93,3 +93,28 @@ def test_top_zero_takes_every_policy_from_since_on(tmp_path, kept_run, capsys):
     assert steps == [200, 300]
     code, _, err = run_cli(["select", kept_run, "--since", -1], capsys)
     assert code == 2 and "--since" in err and len(err.strip().splitlines()) == 1
+
+
+def test_finalists_are_the_winner_and_the_incumbent_or_the_runner_up():
+    assert finalists([250.0, 280.0, 270.0], named=1) == [1, 0]  # winner against the incumbent
+    assert finalists([290.0, 280.0, 270.0], named=1) == [0]  # the incumbent won: nothing to confirm
+    assert finalists([250.0, 280.0, 270.0], named=0) == [1, 2]  # winner against the runner-up
+    assert finalists([250.0], named=0) == [0]
+
+
+def test_confirm_plays_the_finalists_on_the_next_seeds(tmp_path, kept_run, capsys):
+    """The choice is the confirmation round's winner, on seeds after the first round's."""
+    report = tmp_path / "select.json"
+    args = ["select", kept_run, "--top", 0, "--episodes", 2, "--confirm", 3, "--workers", 1]
+    code, stdout, err = run_cli([*args, "--json", report], capsys)
+    assert code == 0, err
+    data = json.loads(report.read_text())
+    first = {r["path"]: r["held_out"]["mean"] for r in data["candidates"]}
+    final = {r["path"]: r["held_out"]["mean"] for r in data["confirm"]["finalists"]}
+    assert data["confirm"]["seeds"] == [2_000_002, 2_000_004]
+    assert len(final) == 2 and max(first, key=first.get) in final
+    assert data["chosen"] == max(final, key=final.get)
+    assert all(r["held_out"]["episodes"] == 3 for r in data["confirm"]["finalists"])
+    assert "confirmation: env seeds 2000002..2000004" in stdout
+    code, _, err = run_cli(["select", kept_run, "--confirm", -1], capsys)
+    assert code == 2 and "--confirm" in err and len(err.strip().splitlines()) == 1
