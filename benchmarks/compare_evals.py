@@ -2,6 +2,8 @@
 
     python benchmarks/compare_evals.py docs/runs/hardcore-direct-seed0 \\
         docs/runs/hardcore-lrdecay-seed0 --from 1100000
+    python benchmarks/compare_evals.py docs/runs/hardcore-lrdecay-seed0 \\
+        docs/runs/hardcore-h8-curated-seed0 --to 300000     # two runs at equal steps
 
 Prints one row per evaluation step (each run's mean and falls there), then per run: how many
 evaluations, their mean and median, the best, the mean falls per evaluation, every 100-episode
@@ -22,19 +24,23 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from bipedal_cli.metrics import METRICS_FILE, read_metrics  # noqa: E402
 
 
-def evaluations(path: Path, first: int, kind: str = "eval") -> dict[int, tuple[float, int]]:
+def evaluations(
+    path: Path, first: int, kind: str = "eval", last: int | None = None
+) -> dict[int, tuple[float, int]]:
     rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
     return {
         int(r["step"]): (float(r["return"]), int(float(r["fell"])))
         for r in rows
-        if r["kind"] == kind and int(r["step"]) >= first
+        if r["kind"] == kind and first <= int(r["step"]) <= (last if last is not None else 1 << 62)
     }
 
 
-def training_episodes(path: Path, first: int) -> tuple[int, float, float]:
-    """Training episodes ending after ``first``: count, mean env return, fraction that fell."""
+def training_episodes(path: Path, first: int, last: int | None = None) -> tuple[int, float, float]:
+    """Training episodes ending after ``first`` (and at or before ``last``): count, mean env
+    return, fraction that fell."""
     rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
-    mine = [r for r in rows if r["kind"] == "episode" and int(r["step"]) > first]
+    end = last if last is not None else 1 << 62
+    mine = [r for r in rows if r["kind"] == "episode" and first < int(r["step"]) <= end]
     if not mine:
         return 0, float("nan"), float("nan")
     returns = [float(r["return"]) for r in mine]
@@ -60,9 +66,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("runs", nargs="+", type=Path)
     parser.add_argument("--from", dest="first", type=int, default=0, help="first policy step")
+    parser.add_argument(
+        "--to", dest="last", type=int, help="last policy step (runs of unequal length)"
+    )
     args = parser.parse_args()
     names = [p.name for p in args.runs]
-    evals = [evaluations(p, args.first) for p in args.runs]
+    evals = [evaluations(p, args.first, last=args.last) for p in args.runs]
     print("| policy step | " + " | ".join(names) + " |")
     print("|---|" + "---|" * len(names))
     for step in sorted(set().union(*evals)):
@@ -83,8 +92,8 @@ def main() -> None:
             continue
         means = [m for m, _ in e.values()]
         best = max(e, key=lambda s: e[s][0])
-        tests = evaluations(path, args.first, "full_eval")
-        count, mean_return, fell = training_episodes(path, args.first)
+        tests = evaluations(path, args.first, "full_eval", args.last)
+        count, mean_return, fell = training_episodes(path, args.first, args.last)
         test_text = ", ".join(f"{m:.1f} ({f} falls) at {s:,}" for s, (m, f) in tests.items())
         print(
             f"| {name} | {len(e)} | {statistics.mean(means):.1f} | "
