@@ -86,6 +86,8 @@ class TrainingDisplay:
             "learning rate",
             _num(s.get("lr"), "{:.2e}"),
         )
+        if s.get("replay_kept") is not None:  # train.replay_keep_below: FORK's curation
+            table.add_row("replay kept", _num(s["replay_kept"], "{:.0%}"))
         return table
 
     # Reporter protocol
@@ -106,7 +108,12 @@ class TrainingDisplay:
                 f"step {s['step']:,}  episodes {s.get('episodes', 0):,}  "
                 f"steps/s {_num(s.get('steps_per_s'))}  return (avg 10) "
                 f"{_num(s.get('avg_return'))}  falls {_num(s.get('fall_rate'), '{:.0%}')}  "
-                f"last eval {_num(s.get('last_eval'))}  alpha {_num(s.get('alpha'), '{:.4f}')}",
+                f"last eval {_num(s.get('last_eval'))}  alpha {_num(s.get('alpha'), '{:.4f}')}"
+                + (
+                    f"  replay kept {s['replay_kept']:.0%}"
+                    if s.get("replay_kept") is not None
+                    else ""
+                ),
                 soft_wrap=True,
             )
 

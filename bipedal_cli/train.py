@@ -52,6 +52,7 @@ from .rundir import (
 )
 from .schedule import scheduled_learning_rate
 from .signals import stop_on_signals
+from .snapshot import training_snapshot
 
 
 @dataclass
@@ -313,29 +314,8 @@ class Trainer:
         }
 
     def snapshot(self, steps_per_s: float) -> dict[str, Any]:
-        recent = list(self.recent_returns)
         self._loss_metrics()
-        return {
-            "phase": "warm-up" if self.step < self.cfg.train.warmup_steps else "training",
-            "step": self.step,
-            "episodes": self.episodes,
-            "steps_per_s": steps_per_s,
-            "last_return": recent[-1] if recent else None,
-            "avg_return": float(np.mean(recent[-10:])) if recent else None,
-            "last_eval": self.last_eval["mean"] if self.last_eval else None,
-            "last_eval_falls": (
-                f"{self.last_eval['falls']}/{self.last_eval['episodes']}"
-                if self.last_eval
-                else None
-            ),
-            "fall_rate": sum(self.recent_falls) / len(self.recent_falls)
-            if self.recent_falls
-            else None,
-            "falls_over": len(self.recent_falls),
-            "wall_time": self.wall_time,
-            "lr": self.agent.learning_rate(),
-            **self.last_metrics,
-        }
+        return training_snapshot(self, steps_per_s)
 
 
 def train(

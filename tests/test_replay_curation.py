@@ -114,3 +114,48 @@ def test_resume_is_exact_with_curation_and_it_changes_the_run(tmp_path):
     train(config_from_dict(featured(total_steps=400)), tmp_path / "plain")
     plain = load_checkpoint(tmp_path / "plain" / "state.pt")
     assert not np.array_equal(plain["buffer"]["obs"].numpy(), a["buffer"]["obs"].numpy())
+
+
+def test_the_display_shows_the_share_of_recent_episodes_the_curation_kept():
+    from rich.console import Console
+
+    from bipedal_cli.display import TrainingDisplay
+    from bipedal_cli.snapshot import replay_kept_share
+
+    returns, falls = [300.0, 100.0, 280.0, 290.0], [False, False, True, False]
+    assert replay_kept_share(returns, falls, 250.0) == 0.5  # the low one and the fall
+    assert replay_kept_share(returns, falls, None) is None
+    assert replay_kept_share([], [], 250.0) is None
+    display = TrainingDisplay(Console(width=200, record=True))
+    display.snapshot = {"step": 10, "replay_kept": 0.5}
+    display.console.print(display.stats_table())
+    assert "replay kept  50%" in display.console.export_text()
+    display.snapshot = {"step": 10, "replay_kept": None}
+    display.console.print(display.stats_table())
+    assert "replay kept" not in display.console.export_text()
+
+
+def test_the_snapshot_reports_the_kept_share_once_curation_has_started():
+    from types import SimpleNamespace
+
+    from bipedal_cli.config import Config
+    from bipedal_cli.snapshot import training_snapshot
+
+    cfg = Config()
+    cfg.train.replay_keep_below, cfg.train.replay_curation_start = 250.0, 500
+    trainer = SimpleNamespace(
+        cfg=cfg,
+        step=499,
+        episodes=3,
+        wall_time=1.0,
+        recent_returns=[300.0, 100.0, 290.0],
+        recent_falls=[False, False, True],
+        last_eval=None,
+        last_metrics={},
+        agent=SimpleNamespace(learning_rate=lambda: 7.3e-4),
+    )
+    assert training_snapshot(trainer, 0.0)["replay_kept"] is None  # before its start
+    trainer.step = 500
+    assert training_snapshot(trainer, 0.0)["replay_kept"] == pytest.approx(2 / 3)
+    cfg.train.replay_keep_below = None
+    assert training_snapshot(trainer, 0.0)["replay_kept"] is None

@@ -1,0 +1,43 @@
+"""What the live display shows of a training run: a plain dict built from the trainer's
+counters (:func:`training_snapshot`), and the statistics over its recent episodes."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+
+def replay_kept_share(
+    returns: Sequence[float], falls: Sequence[bool], keep_below: float | None
+) -> float | None:
+    """The share of recent episodes that FORK's replay curation let into the replay buffer:
+    those that fell or whose env return is below ``keep_below``. None without curation or
+    without episodes."""
+    if keep_below is None or not returns:
+        return None
+    return float(np.mean([f or r < keep_below for r, f in zip(returns, falls, strict=True)]))
+
+
+def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
+    """The display's view of a :class:`~bipedal_cli.train.Trainer` (its losses already read)."""
+    recent, falls, t = list(trainer.recent_returns), list(trainer.recent_falls), trainer.cfg.train
+    last_eval = trainer.last_eval
+    curating = t.replay_keep_below is not None and trainer.step >= t.replay_curation_start
+    return {
+        "phase": "warm-up" if trainer.step < t.warmup_steps else "training",
+        "step": trainer.step,
+        "episodes": trainer.episodes,
+        "steps_per_s": steps_per_s,
+        "last_return": recent[-1] if recent else None,
+        "avg_return": float(np.mean(recent[-10:])) if recent else None,
+        "last_eval": last_eval["mean"] if last_eval else None,
+        "last_eval_falls": (f"{last_eval['falls']}/{last_eval['episodes']}" if last_eval else None),
+        "fall_rate": sum(falls) / len(falls) if falls else None,
+        "falls_over": len(falls),
+        "replay_kept": replay_kept_share(recent, falls, t.replay_keep_below if curating else None),
+        "wall_time": trainer.wall_time,
+        "lr": trainer.agent.learning_rate(),
+        **trainer.last_metrics,
+    }
