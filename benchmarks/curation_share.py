@@ -20,6 +20,7 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from bipedal_cli.episodes import curation_keeps  # noqa: E402
 from bipedal_cli.metrics import METRICS_FILE, read_metrics  # noqa: E402
 
 
@@ -31,7 +32,8 @@ def stored_share(rows: list[dict], threshold: float, start: int, every: int) -> 
     for r in (r for r in rows if r["kind"] == "episode"):
         step = int(r["step"])
         steps = step - previous
-        stored = previous < start or bool(int(float(r["fell"]))) or float(r["return"]) < threshold
+        fell = bool(int(float(r["fell"])))
+        stored = previous < start or curation_keeps(fell, float(r["return"]), threshold)
         span = spans.setdefault(step // every, [0, 0, 0, 0])
         span[0] += 1
         span[1] += stored

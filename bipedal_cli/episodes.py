@@ -13,9 +13,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .buffer import ReplayBuffer
-from .config import Config
+from .config import Config, TrainConfig
 from .envs import make_env
 from .nstep import NStepAccumulator
+
+
+def curation_on(train: TrainConfig, step: int) -> bool:
+    """Whether FORK's replay curation holds the transitions of an episode starting at ``step``."""
+    return train.replay_keep_below is not None and step >= train.replay_curation_start
+
+
+def curation_keeps(fell: bool, env_return: float, keep_below: float) -> bool:
+    """FORK's rule: a curated episode enters the replay buffer only if it fell or its env return
+    is below ``keep_below``."""
+    return fell or env_return < keep_below
 
 
 @dataclass
@@ -89,7 +100,9 @@ class EpisodeRunner:
         self.obs = next_obs.astype(np.float32)
         if terminated or truncated:
             e, fell = self.episode, bool(info["fell"])
-            stored = not e.curated or fell or e.env_ret < self.cfg.train.replay_keep_below
+            stored = not e.curated or curation_keeps(
+                fell, e.env_ret, self.cfg.train.replay_keep_below
+            )
             if e.curated and stored:
                 for transition in self.staged:
                     self.buffer.add(*transition)

@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from .episodes import curation_keeps, curation_on
+
 
 def replay_kept_share(
     returns: Sequence[float], falls: Sequence[bool], keep_below: float | None
@@ -17,14 +19,16 @@ def replay_kept_share(
     without episodes."""
     if keep_below is None or not returns:
         return None
-    return float(np.mean([f or r < keep_below for r, f in zip(returns, falls, strict=True)]))
+    return float(
+        np.mean([curation_keeps(f, r, keep_below) for r, f in zip(returns, falls, strict=True)])
+    )
 
 
 def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
     """The display's view of a :class:`~bipedal_cli.train.Trainer` (its losses already read)."""
     recent, falls, t = list(trainer.recent_returns), list(trainer.recent_falls), trainer.cfg.train
     last_eval = trainer.last_eval
-    curating = t.replay_keep_below is not None and trainer.step >= t.replay_curation_start
+    curating = curation_on(t, trainer.step)
     return {
         "phase": "warm-up" if trainer.step < t.warmup_steps else "training",
         "step": trainer.step,

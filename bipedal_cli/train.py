@@ -36,7 +36,7 @@ from .checkpoint import (
 from .config import Config
 from .devices import configure_threads, resolve_device
 from .envs import policy_dims
-from .episodes import EpisodeRunner, FinishedEpisode
+from .episodes import EpisodeRunner, FinishedEpisode, curation_on
 from .errors import UserError
 from .metrics import METRICS_FILE, MetricsWriter
 from .periodic_eval import evaluate_on_eval_seeds, periodic_evaluation
@@ -258,8 +258,7 @@ class Trainer:
         self._start_episode()
 
     def _start_episode(self) -> None:
-        t = self.cfg.train
-        curated = t.replay_keep_below is not None and self.step >= t.replay_curation_start
+        curated = curation_on(self.cfg.train, self.step)
         self.runner.start(int(self.rng.integers(2**31 - 1)), curated)
 
     def _env_step(self, metrics: MetricsWriter, wall_base: float, session_start: float) -> None:
