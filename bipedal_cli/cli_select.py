@@ -50,9 +50,9 @@ def select(
     ] = 0,
     workers: Annotated[int, typer.Option("--workers", help="Processes (0: every core).")] = 0,
 ) -> None:
-    """Choose among runs' policies: the top K by periodic evaluation from step S on (and every
-    policy file named), re-evaluated on held-out seeds; the best there is the choice (its
-    `bipedal eval` is then a clean estimate)."""
+    """Choose the policy that scores best on held-out seeds among runs' kept policies.
+
+    Its `bipedal eval` on seeds 0-99 is then an estimate that did not choose it."""
     check_count("--top", top, low=0)
     if since < 0:
         raise UserError(f"--since {since}: expected a non-negative policy step")

@@ -123,8 +123,9 @@ def resume(
         Path | None,
         typer.Option(
             "--config",
-            help="With --into: the branch's config (the run's, plus a learning-rate decay that "
-            "starts at or after the run's step; default: the run's own).",
+            help="With --into: the branch's config (the run's, plus features that start at or "
+            "after the run's step: learning-rate decay, replay curation, fall-penalty ramp; "
+            "default: the run's own).",
         ),
     ] = None,
     set_: Annotated[

@@ -9,9 +9,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import math
-import types
-import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,6 +16,7 @@ from typing import Any
 import yaml
 
 from .errors import UserError
+from .typed_fill import fill_dataclass
 from .validation import validate
 
 ENV_ALIASES = {
@@ -139,6 +137,12 @@ class TrainConfig:
     fall_penalty: float | None = None
     """Training only: the reward the learner sees when the walker falls, instead of the env's
     -100 (null: unchanged). Evaluations always score the env's own reward."""
+    fall_penalty_final: float | None = None
+    """Training only: the fall penalty moves linearly from ``fall_penalty`` to this between
+    policy steps ``fall_penalty_ramp_start`` and ``fall_penalty_ramp_end``, and stays there; an
+    episode keeps the penalty of the step it starts at. null: ``fall_penalty`` throughout."""
+    fall_penalty_ramp_start: int = 0
+    fall_penalty_ramp_end: int = 0
     reward_scale: float = 1.0
     """Training only: the learner's rewards (fall penalty included) are multiplied by this."""
 
@@ -173,67 +177,9 @@ class Config:
         return dataclasses.asdict(self)
 
 
-def _type_name(tp: Any) -> str:
-    if isinstance(tp, type):
-        return tp.__name__
-    return str(tp).replace("typing.", "")
-
-
-def _coerce(value: Any, tp: Any, key: str, source: str) -> Any:
-    """Check ``value`` against the annotated type ``tp``; ints are accepted for floats."""
-    if isinstance(value, float) and not math.isfinite(value):
-        raise UserError(f"{source}: key {key!r} expects a finite number, got {value!r}")
-    origin = typing.get_origin(tp)
-    if origin in (typing.Union, types.UnionType):
-        args = typing.get_args(tp)
-        if value is None and type(None) in args:
-            return None
-        for arg in args:
-            if arg is type(None):
-                continue
-            try:
-                return _coerce(value, arg, key, source)
-            except UserError:
-                pass
-        raise UserError(f"{source}: key {key!r} expects {_type_name(tp)}, got {value!r}")
-    if tp is bool:
-        if isinstance(value, bool):
-            return value
-    elif tp is int:
-        if isinstance(value, int) and not isinstance(value, bool):
-            return value
-        if isinstance(value, float) and value.is_integer():
-            return int(value)
-    elif tp is float:
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
-            return float(value)
-    elif tp is str:
-        if isinstance(value, str):
-            return value
-    raise UserError(f"{source}: key {key!r} expects {_type_name(tp)}, got {value!r}")
-
-
-def _fill(obj: Any, data: dict[str, Any], prefix: str, source: str) -> None:
-    if not isinstance(data, dict):
-        raise UserError(
-            f"{source}: section {prefix.rstrip('.') or 'top level'!r} must be a mapping"
-        )
-    hints = typing.get_type_hints(type(obj))
-    names = {f.name for f in dataclasses.fields(obj)}
-    for key, value in data.items():
-        full = f"{prefix}{key}"
-        if key not in names:
-            raise UserError(f"{source}: unknown key {full!r}; expected one of {sorted(names)}")
-        current = getattr(obj, key)
-        if dataclasses.is_dataclass(current):
-            _fill(current, value, f"{full}.", source)
-        else:
-            setattr(obj, key, _coerce(value, hints[key], full, source))
-
-
 def config_from_dict(data: dict[str, Any], source: str = "config") -> Config:
     cfg = Config()
-    _fill(cfg, data or {}, "", source)
+    fill_dataclass(cfg, data or {}, source)
     cfg.env = canonical_env_id(cfg.env, f"{source}: key 'env'")
     validate(cfg, source)  # the range of every value (validation.py)
     return cfg

@@ -86,8 +86,13 @@ class TrainingDisplay:
             "learning rate",
             _num(s.get("lr"), "{:.2e}"),
         )
+        extra = []
         if s.get("replay_kept") is not None:  # train.replay_keep_below: FORK's curation
-            table.add_row("replay kept", _num(s["replay_kept"], "{:.0%}"))
+            extra += ["replay kept", _num(s["replay_kept"], "{:.0%}")]
+        if s.get("fall_penalty") is not None:  # train.fall_penalty_final: a ramp
+            extra += ["fall penalty", _num(s["fall_penalty"], "{:.1f}")]
+        if extra:
+            table.add_row(*extra)
         return table
 
     # Reporter protocol
@@ -112,6 +117,11 @@ class TrainingDisplay:
                 + (
                     f"  replay kept {s['replay_kept']:.0%}"
                     if s.get("replay_kept") is not None
+                    else ""
+                )
+                + (
+                    f"  fall penalty {s['fall_penalty']:.1f}"
+                    if s.get("fall_penalty") is not None
                     else ""
                 ),
                 soft_wrap=True,

@@ -39,6 +39,7 @@ class EpisodeState:
     env_ret: float = 0.0  # the env's own return
     env_steps: int = 0  # env steps (action repeat: several per action)
     curated: bool = False  # its transitions wait for its end, then are kept or dropped
+    fall_penalty: float | None = None  # what the learner sees on a fall (None: the env's -100)
 
 
 @dataclass
@@ -63,8 +64,8 @@ class EpisodeRunner:
         self.cfg, self.buffer = cfg, buffer
         n = cfg.agent.n_step
         self.nstep = NStepAccumulator(n, cfg.agent.gamma) if n > 1 else None
+        self.episode = EpisodeState(fall_penalty=cfg.train.fall_penalty)
         self.env = self._make_env()
-        self.episode = EpisodeState()
         self.obs: np.ndarray | None = None  # None: no episode in progress
         self.staged: list[tuple] = []  # a curated episode's transitions so far
 
@@ -74,7 +75,7 @@ class EpisodeRunner:
             self.cfg.env,
             action_repeat=a.action_repeat,
             history=a.history,
-            fall_penalty=t.fall_penalty,
+            fall_penalty=self.episode.fall_penalty,
             reward_scale=t.reward_scale,
         )
 
@@ -82,12 +83,14 @@ class EpisodeRunner:
         self.env.close()
         self.env = self._make_env()  # follows cfg.env, which a curriculum switches
 
-    def start(self, seed: int, curated: bool = False) -> None:
-        """A new episode on a new env reset with ``seed``."""
+    def start(self, seed: int, curated: bool, fall_penalty: float | None) -> None:
+        """A new episode on a new env reset with ``seed``; ``curated`` and ``fall_penalty`` hold
+        to its end (:func:`curation_on` and :func:`~bipedal_cli.schedule.fall_penalty_at` at
+        the step it starts)."""
+        self.episode = EpisodeState(seed=seed, curated=curated, fall_penalty=fall_penalty)
         self._fresh_env()
         obs, _ = self.env.reset(seed=seed)
         self.obs = obs.astype(np.float32)
-        self.episode = EpisodeState(seed=seed, curated=curated)
         self.staged = []
         if self.nstep is not None:
             self.nstep.reset()
@@ -133,12 +136,17 @@ class EpisodeRunner:
             self.buffer.add(*transition)
 
     def replay(
-        self, seed: int, actions: np.ndarray, expected_obs: np.ndarray, curated: bool = False
+        self,
+        seed: int,
+        actions: np.ndarray,
+        expected_obs: np.ndarray,
+        curated: bool,
+        fall_penalty: float | None,
     ) -> bool:
         """Rebuild an interrupted episode (its transitions are in the buffer already, or, when
         curated, staged again); False when the rebuilt observation differs from
         ``expected_obs``."""
-        self.start(seed, curated)
+        self.start(seed, curated, fall_penalty)
         for action in actions:
             next_obs, reward, terminated, truncated, info = self.env.step(action)
             if curated:
@@ -158,5 +166,6 @@ class EpisodeRunner:
             "actions": torch.from_numpy(np.array(e.actions, np.float32).reshape(-1, act_dim)),
             "ret": e.ret,  # rebuilt by replay; kept as older versions read it
             "curated": e.curated,
+            "fall_penalty": e.fall_penalty,
             "obs": None if self.obs is None else torch.from_numpy(self.obs.copy()),
         }

@@ -83,8 +83,14 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
     trainer._update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
     ep = state["episode"]
     if ep["obs"] is not None:
+        # checkpoints before the fall-penalty ramp had one penalty: the config's
+        penalty = ep["fall_penalty"] if "fall_penalty" in ep else trainer.cfg.train.fall_penalty
         rebuilt = trainer.runner.replay(
-            int(ep["seed"]), ep["actions"].numpy(), ep["obs"].numpy(), bool(ep.get("curated"))
+            int(ep["seed"]),
+            ep["actions"].numpy(),
+            ep["obs"].numpy(),
+            bool(ep.get("curated")),
+            None if penalty is None else float(penalty),
         )
         if not rebuilt:
             trainer.reporter.log(

@@ -1,8 +1,10 @@
-"""The learning-rate schedule: constant, or a linear decay over a window of policy steps.
+"""Schedules over policy steps: constant, or linear over a window, for the learning rate and the
+fall penalty the learner sees.
 
 rl-zoo's tuned TQC for BipedalWalkerHardcore-v3 decays its learning rate linearly over the run;
-ours is constant unless ``agent.lr_final`` is set. The schedule is a pure function of the policy
-step, so it adds nothing to a checkpoint and a resumed run follows it exactly.
+ours is constant unless ``agent.lr_final`` is set. The fall penalty is constant unless
+``train.fall_penalty_final`` is set. Each is a pure function of the policy step, so it adds
+nothing to a checkpoint and a resumed run follows it exactly.
 """
 
 from __future__ import annotations
@@ -21,11 +23,17 @@ def learning_rate_at(step: int, lr: float, final: float | None, start: int, end:
     itself (no arithmetic), so a run that switches the decay on at a step it has not reached
     yet is, up to that step, the same run to the bit.
     """
+    return linear_ramp(step, lr, final, start, end)
+
+
+def linear_ramp(step: int, first: float, final: float | None, start: int, end: int) -> float:
+    """``first`` up to ``start``, ``final`` from ``end`` on, linear in between (see
+    :func:`learning_rate_at`); ``final`` None: always ``first``. ``end`` == ``start`` is a step."""
     if final is None or step <= start:
-        return lr
+        return first
     if step >= end:
         return final
-    return lr + (final - lr) * (step - start) / (end - start)
+    return first + (final - first) * (step - start) / (end - start)
 
 
 def scheduled_learning_rate(step: int, agent_cfg: Any) -> float | None:
@@ -35,4 +43,25 @@ def scheduled_learning_rate(step: int, agent_cfg: Any) -> float | None:
         return None
     return learning_rate_at(
         step, agent_cfg.lr, agent_cfg.lr_final, agent_cfg.lr_decay_start, agent_cfg.lr_decay_end
+    )
+
+
+def fall_penalty_at(step: int, train_cfg: Any) -> float | None:
+    """The fall penalty for an episode that starts at policy step ``step`` (an episode keeps one
+    penalty to its end):
+
+        p(t) = fall_penalty                                            t <= start
+        p(t) = fall_penalty + (final - fall_penalty) (t - start) / (end - start)  start < t < end
+        p(t) = final                                                   t >= end
+
+    None (the env's own -100) when ``train.fall_penalty`` is None."""
+    t = train_cfg
+    if t.fall_penalty is None:
+        return None
+    return linear_ramp(
+        step,
+        t.fall_penalty,
+        t.fall_penalty_final,
+        t.fall_penalty_ramp_start,
+        t.fall_penalty_ramp_end,
     )

@@ -108,6 +108,13 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
     if actions.dim() != 2 or actions.shape[1] != act_dim:
         raise _fail(where, "episode.actions", f"should be (steps, {act_dim})")
     _get(episode, "seed", int, where, "episode.")
+    penalty = episode.get("fall_penalty")  # since 2026-11-25; before, the config's throughout
+    if penalty is not None and (
+        isinstance(penalty, bool)
+        or not isinstance(penalty, (int, float))
+        or not math.isfinite(penalty)
+    ):
+        raise _fail(where, "episode.fall_penalty", "should be null or a finite number")
     _get(data, "rng", Mapping, where)
     _get(data, "recent_returns", list, where)
     if "recent_falls" in data:  # since 2026-11-24; older checkpoints start it empty

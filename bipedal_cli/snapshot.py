@@ -43,5 +43,9 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         "replay_kept": replay_kept_share(recent, falls, t.replay_keep_below if curating else None),
         "wall_time": trainer.wall_time,
         "lr": trainer.agent.learning_rate(),
+        # with a ramp (train.fall_penalty_final), the penalty of the episode in progress
+        "fall_penalty": (
+            trainer.runner.episode.fall_penalty if t.fall_penalty_final is not None else None
+        ),
         **trainer.last_metrics,
     }

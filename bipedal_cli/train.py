@@ -50,7 +50,7 @@ from .rundir import (
     write_config,
     write_plot,
 )
-from .schedule import scheduled_learning_rate
+from .schedule import fall_penalty_at, scheduled_learning_rate
 from .signals import stop_on_signals
 from .snapshot import training_snapshot
 
@@ -258,8 +258,9 @@ class Trainer:
         self._start_episode()
 
     def _start_episode(self) -> None:
-        curated = curation_on(self.cfg.train, self.step)
-        self.runner.start(int(self.rng.integers(2**31 - 1)), curated)
+        t = self.cfg.train
+        seed = int(self.rng.integers(2**31 - 1))
+        self.runner.start(seed, curation_on(t, self.step), fall_penalty_at(self.step, t))
 
     def _env_step(self, metrics: MetricsWriter, wall_base: float, session_start: float) -> None:
         if self.step < self.cfg.train.warmup_steps:

@@ -89,6 +89,17 @@ def validate(cfg: Any, source: str) -> None:
             "agent.lr_decay_end",
             "a step after agent.lr_decay_start (with agent.lr_final set)",
         ),
+        (
+            t.fall_penalty_final is None or t.fall_penalty is not None,
+            "train.fall_penalty_final",
+            "null unless train.fall_penalty is set (the ramp starts from it)",
+        ),
+        (t.fall_penalty_ramp_start >= 0, "train.fall_penalty_ramp_start", "a non-negative step"),
+        (
+            t.fall_penalty_ramp_end >= t.fall_penalty_ramp_start,
+            "train.fall_penalty_ramp_end",
+            "a step at or after train.fall_penalty_ramp_start",
+        ),
         (t.reward_scale > 0, "train.reward_scale", "a positive number"),
         (t.total_steps >= 0, "train.total_steps", "a non-negative integer"),
         (t.warmup_steps >= 0, "train.warmup_steps", "a non-negative integer"),
@@ -150,6 +161,16 @@ DEFERRED = (
         lambda c: c.train.replay_keep_below is not None,
         lambda c: c.train.replay_curation_start,
     ),
+    (
+        (
+            "train.fall_penalty_final",
+            "train.fall_penalty_ramp_start",
+            "train.fall_penalty_ramp_end",
+        ),
+        "train.fall_penalty_ramp_start",
+        lambda c: c.train.fall_penalty_final is not None,
+        lambda c: c.train.fall_penalty_ramp_start,
+    ),
 )
 
 
@@ -187,5 +208,5 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
             f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
             "change only device, train.threads, train.total_steps, train.keep_policies and "
             "features that start at or after the branch point (learning-rate decay, replay "
-            "curation)"
+            "curation, fall-penalty ramp)"
         )

@@ -22,6 +22,7 @@ SHIPPED = {
     "hardcore-curriculum": ("BipedalWalker-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-h8-curated": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
+    "hardcore-h8-fallramp": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
 }
 
 
@@ -64,6 +65,22 @@ def test_hardcore_h8_curated_is_lrdecay_with_history_8_and_fork_curation():
     assert h8.train.keep_policies
     h8.agent.history, h8.train.replay_keep_below, h8.train.keep_policies = 4, None, False
     assert h8 == decay
+
+
+def test_hardcore_h8_fallramp_is_h8_curated_until_its_ramp_starts():
+    """It branches from hardcore-h8-curated.yaml's run: nothing but the ramp may differ."""
+    h8, ramp = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-h8-curated", "hardcore-h8-fallramp")
+    )
+    t = ramp.train
+    assert (t.fall_penalty_final, t.fall_penalty_ramp_start, t.fall_penalty_ramp_end) == (
+        -30.0,
+        1_280_000,
+        1_380_000,
+    )
+    t.fall_penalty_final, t.fall_penalty_ramp_start, t.fall_penalty_ramp_end = None, 0, 0
+    assert ramp == h8
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():

@@ -58,7 +58,7 @@ def runner_with(episodes, n_step=1, keep_below=5.0):
 
 
 def play(runner, seed, curated):
-    runner.start(seed, curated)
+    runner.start(seed, curated, None)
     while (done := runner.step(np.zeros(4, np.float32))) is None:
         pass
     return done
@@ -82,13 +82,13 @@ def test_only_failed_or_low_scoring_curated_episodes_are_stored(n_step):
 
 def test_replay_restages_a_curated_episode_cut_by_a_checkpoint():
     runner, buffer = runner_with([(8, True), (8, True)], n_step=3)
-    runner.start(7, curated=True)
+    runner.start(7, True, None)
     actions = [np.full(4, i / 10, np.float32) for i in range(5)]
     for a in actions:
         runner.step(a)
     staged, obs = runner.staged, runner.obs
     assert len(staged) == 3 and len(buffer) == 0  # 5 steps, 2 still pending in the n-step queue
-    assert runner.replay(7, np.array(actions), obs, curated=True)
+    assert runner.replay(7, np.array(actions), obs, True, None)
     assert len(runner.staged) == len(staged) and len(buffer) == 0
     for a, b in zip(runner.staged, staged, strict=True):
         assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
