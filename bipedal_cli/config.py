@@ -142,7 +142,9 @@ class TrainConfig:
     policy steps ``fall_penalty_ramp_start`` and ``fall_penalty_ramp_end``, and stays there; an
     episode keeps the penalty of the step it starts at. null: ``fall_penalty`` throughout."""
     fall_penalty_ramp_start: int = 0
+    """Policy step where the ramp starts (an episode starting there or before: ``fall_penalty``)."""
     fall_penalty_ramp_end: int = 0
+    """Policy step where it reaches ``fall_penalty_final`` (episodes from there on see that)."""
     reward_scale: float = 1.0
     """Training only: the learner's rewards (fall penalty included) are multiplied by this."""
 
