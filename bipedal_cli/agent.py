@@ -76,6 +76,8 @@ class TQCAgent:
         self.alpha_opt = torch.optim.Adam([self.log_alpha], **adam)
         self.noise = torch.Generator(device=self.device)  # exploration noise, checkpointed
         self.updates = 0
+        # the actor's objective: the mean of all atoms (None) or of the lowest L (schedule.py)
+        self.actor_lowest_atoms: int | None = None
         self._online = list(self.critic.parameters())
         self._target = list(self.critic_target.parameters())
 
@@ -245,7 +247,7 @@ class TQCAgent:
         of eq. (3)."""
         new_action, log_prob = self.actor.sample(obs, eps=eps)  # (B, A), (B,)
         new_atoms = self.critic(obs, new_action, detach_params=True)  # (B, N, M)
-        pi_loss = actor_loss(log_prob, new_atoms, alpha)
+        pi_loss = actor_loss(log_prob, new_atoms, alpha, self.actor_lowest_atoms)
         self.actor_opt.zero_grad(set_to_none=True)
         pi_loss.backward()
         alpha_loss = temperature_loss(self.log_alpha, log_prob, self.target_entropy)

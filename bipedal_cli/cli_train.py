@@ -124,8 +124,8 @@ def resume(
         typer.Option(
             "--config",
             help="With --into: the branch's config (the run's, plus features that start at or "
-            "after the run's step: learning-rate decay, replay curation, fall-penalty ramp; "
-            "default: the run's own).",
+            "after the run's step: learning-rate decay, replay curation, fall-penalty ramp, "
+            "risk-averse actor; default: the run's own).",
         ),
     ] = None,
     set_: Annotated[

@@ -88,6 +88,13 @@ class AgentConfig:
     """n: targets sum n rewards, y = sum_{j<n} gamma^j r_{t+j} + gamma^n (1 - d) (z - alpha
     log pi); an episode's end inside the n steps cuts the sum (termination also the
     bootstrap)."""
+    actor_cvar: float | None = None
+    """c in (0, 1]: from ``actor_cvar_start`` on, the actor maximises the mean of the lowest
+    c N M (rounded half up) of the critics' N*M pooled atoms, the CVaR_c of their mixture,
+    instead of the mean of all (eq. 2): a risk-averse policy that weighs a fall in the return's
+    lower tail more. None: eq. 2 throughout."""
+    actor_cvar_start: int = 0
+    """Policy step after which the actor's objective is ``actor_cvar``'s (the mean up to it)."""
 
 
 @dataclass

@@ -91,6 +91,8 @@ class TrainingDisplay:
             extra += ["replay kept", _num(s["replay_kept"], "{:.0%}")]
         if s.get("fall_penalty") is not None:  # train.fall_penalty_final: a ramp
             extra += ["fall penalty", _num(s["fall_penalty"], "{:.1f}")]
+        if s.get("actor_cvar") is not None:  # agent.actor_cvar: the risk-averse actor
+            extra += ["actor objective", f"CVaR {s['actor_cvar']:.2f}"]
         if extra:
             table.add_row(*extra)
         return table
@@ -123,7 +125,8 @@ class TrainingDisplay:
                     f"  fall penalty {s['fall_penalty']:.1f}"
                     if s.get("fall_penalty") is not None
                     else ""
-                ),
+                )
+                + (f"  actor CVaR {s['actor_cvar']:.2f}" if s.get("actor_cvar") else ""),
                 soft_wrap=True,
             )
 

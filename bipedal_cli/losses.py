@@ -194,12 +194,31 @@ def quantile_huber_loss(atoms: torch.Tensor, target: torch.Tensor) -> torch.Tens
     return _SortedQuantileHuber.apply(atoms, target)
 
 
-def actor_loss(log_prob: torch.Tensor, atoms: torch.Tensor, alpha: torch.Tensor | float):
+def actor_loss(
+    log_prob: torch.Tensor,
+    atoms: torch.Tensor,
+    alpha: torch.Tensor | float,
+    lowest: int | None = None,
+):
     """Eq. (2): J_pi = E[alpha log pi(a|s) - (1/NM) sum_{n,m} theta_n^m(s, a)], a ~ pi(.|s).
 
     log_prob: (B,), atoms: (B, N, M) at the re-parameterised action; alpha is a constant here.
+
+    With ``lowest`` = L < N*M, the risk-averse objective (``agent.actor_cvar``):
+
+        J_pi = E[alpha log pi(a|s) - (1/L) sum_{j=1..L} theta_(j)(s, a)]
+
+    theta_(j) the j-th smallest of the N*M pooled atoms: each atom weighs 1/(NM) in the mixture
+    of the N critics' distributions, so this is the mixture's CVaR at level L/(NM). The gradient
+    reaches the L atoms that are lowest at the current action.
     """
-    return (alpha * log_prob - atoms.mean(dim=(1, 2))).mean()
+    B, N, M = atoms.shape
+    if lowest is None or lowest >= N * M:
+        value = atoms.mean(dim=(1, 2))  # (B,)
+    else:
+        pooled = atoms.reshape(B, N * M)  # (B, N*M)
+        value = torch.topk(pooled, lowest, dim=1, largest=False, sorted=False).values.mean(1)
+    return (alpha * log_prob - value).mean()
 
 
 def temperature_loss(log_alpha: torch.Tensor, log_prob: torch.Tensor, target_entropy: float):

@@ -1,5 +1,5 @@
 """Schedules over policy steps: constant, or linear over a window, for the learning rate and the
-fall penalty the learner sees.
+fall penalty the learner sees; from a step on, for the actor's risk-averse objective.
 
 rl-zoo's tuned TQC for BipedalWalkerHardcore-v3 decays its learning rate linearly over the run;
 ours is constant unless ``agent.lr_final`` is set. The fall penalty is constant unless
@@ -9,6 +9,7 @@ nothing to a checkpoint and a resumed run follows it exactly.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 
@@ -44,6 +45,19 @@ def scheduled_learning_rate(step: int, agent_cfg: Any) -> float | None:
     return learning_rate_at(
         step, agent_cfg.lr, agent_cfg.lr_final, agent_cfg.lr_decay_start, agent_cfg.lr_decay_end
     )
+
+
+def actor_lowest_atoms(step: int, agent_cfg: Any) -> int | None:
+    """How many of the N*M pooled atoms the actor's objective averages in the update after
+    policy step ``step`` (:func:`~bipedal_cli.losses.actor_loss`'s ``lowest``):
+
+        L(t) = max(1, floor(c N M + 1/2))   t > actor_cvar_start, c = agent.actor_cvar
+        L(t) = None (all: eq. 2)            t <= actor_cvar_start, or c None
+    """
+    a = agent_cfg
+    if a.actor_cvar is None or step <= a.actor_cvar_start:
+        return None
+    return max(1, math.floor(a.actor_cvar * a.n_critics * a.n_quantiles + 0.5))
 
 
 def fall_penalty_at(step: int, train_cfg: Any) -> float | None:

@@ -47,5 +47,9 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         "fall_penalty": (
             trainer.runner.episode.fall_penalty if t.fall_penalty_final is not None else None
         ),
+        # agent.actor_cvar, once the risk-averse objective is on
+        "actor_cvar": (
+            trainer.cfg.agent.actor_cvar if trainer.agent.actor_lowest_atoms is not None else None
+        ),
         **trainer.last_metrics,
     }

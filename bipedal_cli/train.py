@@ -50,7 +50,7 @@ from .rundir import (
     write_config,
     write_plot,
 )
-from .schedule import fall_penalty_at, scheduled_learning_rate
+from .schedule import actor_lowest_atoms, fall_penalty_at, scheduled_learning_rate
 from .signals import stop_on_signals
 from .snapshot import training_snapshot
 
@@ -214,6 +214,7 @@ class Trainer:
                     lr = scheduled_learning_rate(self.step, cfg.agent)
                     if lr is not None:
                         self.agent.set_learning_rate(lr)
+                    self.agent.actor_lowest_atoms = actor_lowest_atoms(self.step, cfg.agent)
                     for _ in range(t.updates_per_step):
                         batch = self.agent.batch_to_tensors(
                             self.buffer.sample(cfg.agent.batch_size, self.rng)

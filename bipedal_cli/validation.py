@@ -83,6 +83,12 @@ def validate(cfg: Any, source: str) -> None:
         (a.n_step >= 1, "agent.n_step", "a positive integer"),
         (a.lr_final is None or a.lr_final >= 0, "agent.lr_final", "null or a number >= 0"),
         (a.lr_decay_start >= 0, "agent.lr_decay_start", "a non-negative integer"),
+        (
+            a.actor_cvar is None or 0.0 < a.actor_cvar <= 1.0,
+            "agent.actor_cvar",
+            "null or a number in (0, 1]",
+        ),
+        (a.actor_cvar_start >= 0, "agent.actor_cvar_start", "a non-negative step"),
         (t.replay_curation_start >= 0, "train.replay_curation_start", "a non-negative integer"),
         (
             a.lr_final is None or a.lr_decay_end > a.lr_decay_start,
@@ -171,6 +177,12 @@ DEFERRED = (
         lambda c: c.train.fall_penalty_final is not None,
         lambda c: c.train.fall_penalty_ramp_start,
     ),
+    (
+        ("agent.actor_cvar", "agent.actor_cvar_start"),
+        "agent.actor_cvar_start",
+        lambda c: c.agent.actor_cvar is not None,
+        lambda c: c.agent.actor_cvar_start,
+    ),
 )
 
 
@@ -188,8 +200,9 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
     """A branch of a run at ``step`` (``bipedal resume RUN --into DIR --config NEW``) must be the
     run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
     threads, budget and kept policies (they do not change the bits), and features that start
-    at a policy step (a learning-rate decay, replay curation) as long as they change nothing
-    before ``step``. One line naming the first key that breaks this."""
+    at a policy step (DEFERRED: learning-rate decay, replay curation, fall-penalty ramp,
+    risk-averse actor) as long as they change nothing before ``step``. One line naming the
+    first key that breaks this."""
     old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
     deferred_keys: set[str] = set()
     for keys, start_key, is_on, start in DEFERRED:
@@ -208,5 +221,5 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
             f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
             "change only device, train.threads, train.total_steps, train.keep_policies and "
             "features that start at or after the branch point (learning-rate decay, replay "
-            "curation, fall-penalty ramp)"
+            "curation, fall-penalty ramp, risk-averse actor)"
         )

@@ -64,6 +64,18 @@ def ref_actor_loss(log_prob, atoms, alpha):
     return total / B
 
 
+def ref_actor_cvar_loss(log_prob, atoms, alpha, lowest):
+    """Eq. 2 with the mean of the ``lowest`` smallest of the N*M pooled atoms (CVaR)."""
+    B, N, M = atoms.shape
+    total = 0.0
+    for b in range(B):
+        pooled = [atoms[b, n, m] for n in range(N) for m in range(M)]
+        pooled.sort(key=lambda z: z.item())
+        q = sum(pooled[:lowest]) / lowest
+        total = total + alpha * log_prob[b] - q
+    return total / B
+
+
 def ref_temperature_loss(log_alpha, log_prob, target_entropy):
     B = log_prob.shape[0]
     total = 0.0

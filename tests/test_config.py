@@ -23,6 +23,7 @@ SHIPPED = {
     "hardcore-lrdecay": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-h8-curated": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
     "hardcore-h8-fallramp": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
+    "hardcore-lrdecay-cvar": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
 }
 
 
@@ -81,6 +82,22 @@ def test_hardcore_h8_fallramp_is_h8_curated_until_its_ramp_starts():
     )
     t.fall_penalty_final, t.fall_penalty_ramp_start, t.fall_penalty_ramp_end = None, 0, 0
     assert ramp == h8
+
+
+def test_hardcore_lrdecay_cvar_is_lrdecay_until_its_actor_turns_risk_averse():
+    """It branches from hardcore-lrdecay.yaml's runs at 1.1M: nothing but the actor's objective
+    may differ, and the branch check accepts it from a run at that step."""
+    from bipedal_cli.schedule import actor_lowest_atoms
+    from bipedal_cli.validation import check_branch_config
+
+    decay, cvar = (
+        resolve_config(CONFIGS / f"{n}.yaml") for n in ("hardcore-lrdecay", "hardcore-lrdecay-cvar")
+    )
+    assert (cvar.agent.actor_cvar, cvar.agent.actor_cvar_start) == (0.5, 1_100_000)
+    assert actor_lowest_atoms(1_100_001, cvar.agent) == 63  # of 125
+    check_branch_config(decay, cvar, 1_100_000, "hardcore-lrdecay-cvar.yaml")
+    cvar.agent.actor_cvar, cvar.agent.actor_cvar_start = None, 0
+    assert cvar == decay
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():
