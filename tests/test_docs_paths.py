@@ -35,7 +35,7 @@ def named_paths(doc: Path) -> set[str]:
     paths = {
         m.group(1).rstrip(".,:;")
         for m in NAMED.finditer(text)
-        if text[m.end() : m.end() + 1] not in ("*", "{", "<")  # a pattern, not a path
+        if text[m.end() : m.end() + 1] not in ("*", "{", "<", "[")  # a pattern, not a path
     }
     for target in LINKED.findall(text):
         if "://" not in target:
