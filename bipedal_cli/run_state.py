@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from .checkpoint import FORMAT_VERSION, TRAIN_FORMAT
+from .checkpoint import FORMAT_VERSION, TRAIN_FORMAT, policy_payload
 
 
 def run_state(trainer: Any) -> dict[str, Any]:
@@ -97,3 +97,26 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
                 "warning: the replayed episode differs from the checkpoint's; the resumed "
                 "run will not match an uninterrupted one exactly"
             )
+
+
+def policy_file(trainer: Any) -> dict[str, Any]:
+    """The ``policy.pt`` of a :class:`~bipedal_cli.train.Trainer`: its actor, config and where
+    the run stood (``bipedal info`` prints the meta)."""
+    meta = {
+        "env": trainer.cfg.env,
+        "seed": trainer.cfg.seed,
+        "steps": trainer.step,
+        "env_steps": trainer.env_steps,
+        "episodes": trainer.episodes,
+        "wall_time": round(trainer.wall_time, 1),
+        "last_eval": trainer.last_eval,
+        "full_eval": trainer.full_eval,
+        "torch": str(torch.__version__),
+    }
+    return policy_payload(
+        trainer.agent.actor.state_dict(),
+        trainer.cfg.to_dict(),
+        trainer.obs_dim,
+        trainer.act_dim,
+        meta,
+    )

@@ -27,12 +27,7 @@ import torch
 
 from .agent import TQCAgent
 from .buffer import ReplayBuffer
-from .checkpoint import (
-    POLICY_FILE,
-    STATE_FILE,
-    atomic_save,
-    policy_payload,
-)
+from .checkpoint import POLICY_FILE, STATE_FILE, atomic_save
 from .config import Config
 from .devices import configure_threads, resolve_device
 from .envs import policy_dims
@@ -41,7 +36,7 @@ from .errors import UserError
 from .metrics import METRICS_FILE, MetricsWriter
 from .periodic_eval import evaluate_on_eval_seeds, periodic_evaluation
 from .reporting import NullReporter, Reporter
-from .run_state import restore_run_state, run_state
+from .run_state import policy_file, restore_run_state, run_state
 from .rundir import (
     default_run_dir,
     lock_run_dir,
@@ -111,19 +106,6 @@ class Trainer:
     def load_state_dict(self, state: dict[str, Any]) -> None:
         restore_run_state(self, state)
 
-    def policy_meta(self) -> dict[str, Any]:
-        return {
-            "env": self.cfg.env,
-            "seed": self.cfg.seed,
-            "steps": self.step,
-            "env_steps": self.env_steps,
-            "episodes": self.episodes,
-            "wall_time": round(self.wall_time, 1),
-            "last_eval": self.last_eval,
-            "full_eval": self.full_eval,
-            "torch": str(torch.__version__),
-        }
-
     def _diverged(self, what: str) -> UserError:
         saved = self.run_dir / STATE_FILE
         return UserError(
@@ -142,14 +124,7 @@ class Trainer:
         self.save_policy(self.run_dir / POLICY_FILE)
 
     def save_policy(self, path: Path) -> None:
-        payload = policy_payload(
-            self.agent.actor.state_dict(),
-            self.cfg.to_dict(),
-            self.obs_dim,
-            self.act_dim,
-            self.policy_meta(),
-        )
-        atomic_save(payload, path)
+        atomic_save(policy_file(self), path)
 
     def evaluate(self, episodes: int) -> dict:
         """``episodes`` deterministic episodes on the periodic evaluations' seeds."""
