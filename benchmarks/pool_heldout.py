@@ -14,7 +14,7 @@ N = sum n_i episodes:
 
     M = (1 / N) sum_i n_i m_i
     S^2 = (1 / N) sum_i n_i (s_i^2 + (m_i - M)^2)          (the population variance of all)
-    95% interval for the mean: M +- 1.96 S / sqrt(N - 1)
+    95% interval for the mean: M +- 1.96 S / sqrt(N - 1)   (bipedal_cli.evaluation.mean_interval)
 
 and for F falls in N episodes the Wilson score interval, z = 1.96, p = F / N:
 
@@ -26,8 +26,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from collections import defaultdict
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from bipedal_cli.evaluation import mean_interval  # noqa: E402
 
 Z95 = 1.96
 
@@ -38,11 +43,6 @@ def pool_blocks(blocks: list[tuple[int, float, float]]) -> tuple[int, float, flo
     mean = sum(n * m for n, m, _ in blocks) / total
     var = sum(n * (s * s + (m - mean) ** 2) for n, m, s in blocks) / total
     return total, mean, math.sqrt(var)
-
-
-def mean_interval(total: int, mean: float, std: float, z: float = Z95) -> tuple[float, float]:
-    half = z * std / math.sqrt(max(total - 1, 1))
-    return mean - half, mean + half
 
 
 def wilson_interval(falls: int, total: int, z: float = Z95) -> tuple[float, float]:

@@ -162,9 +162,16 @@ def falls_text(summary: dict) -> str:
 
 
 def verdict(summary: dict) -> str:
+    """'solved: mean 309.8 > 300 (95% interval 309.0 to 310.6)': the verdict is the mean's; the
+    interval says how far these episodes pin the policy's expected return down."""
+    from .evaluation import mean_interval
+
+    lo, hi = mean_interval(summary["episodes"], summary["mean"], summary["std"])
+    interval = f" (95% interval {lo:.1f} to {hi:.1f})" if summary["episodes"] > 1 else ""
+    mean, threshold = summary["mean"], summary["threshold"]
     if summary["solved"]:
-        return f"[bold green]solved[/]: mean {summary['mean']:.1f} > {summary['threshold']:g}"
-    return f"[bold red]not solved[/]: mean {summary['mean']:.1f} <= {summary['threshold']:g}"
+        return f"[bold green]solved[/]: mean {mean:.1f} > {threshold:g}{interval}"
+    return f"[bold red]not solved[/]: mean {mean:.1f} <= {threshold:g}{interval}"
 
 
 def curriculum_table(result, run_dir: str) -> Table:

@@ -167,3 +167,13 @@ def summarize(results: list[EpisodeResult], threshold: float = 300.0) -> dict:
         "threshold": threshold,
         "solved": bool(returns.mean() > threshold),
     }
+
+
+def mean_interval(episodes: int, mean: float, std: float, z: float = 1.96) -> tuple[float, float]:
+    """The normal-approximation interval for a policy's expected return from ``episodes``
+    returns with mean ``mean`` and population standard deviation ``std`` (``summarize``'s):
+
+        mean +- z std / sqrt(episodes - 1)        z = 1.96: 95%
+    """
+    half = z * std / max(episodes - 1, 1) ** 0.5
+    return mean - half, mean + half

@@ -1,5 +1,6 @@
-"""benchmarks/pool_heldout.py: pooling held-out blocks from their summaries must give what the
-episodes themselves give, and a seed block must count once per policy."""
+"""Intervals on scores: `bipedal eval`'s verdict gives the 95% interval of the mean it reports;
+benchmarks/pool_heldout.py pools held-out blocks from their summaries into what the episodes
+themselves give, and counts a seed block once per policy."""
 
 import importlib.util
 import math
@@ -25,6 +26,26 @@ def test_pooled_summaries_equal_the_statistics_of_all_episodes():
     assert std == pytest.approx(everything.std(), rel=1e-12)
     lo, hi = pool_heldout.mean_interval(total, mean, std)
     assert hi - lo == pytest.approx(2 * 1.96 * everything.std() / math.sqrt(total - 1))
+
+
+def test_the_eval_verdict_gives_the_interval_of_its_mean():
+    from bipedal_cli.display import verdict
+    from bipedal_cli.evaluation import summarize
+
+    class Episode:
+        def __init__(self, ret):
+            self.ret, self.length, self.fell, self.fell_at = ret, 1000, ret < 0, None
+
+    returns = [310.0, 305.0, 300.0, -50.0, 295.0]
+    summary = summarize([Episode(r) for r in returns])
+    half = 1.96 * np.std(returns) / 2.0  # sqrt(5 - 1)
+    mean = np.mean(returns)
+    assert verdict(summary) == (
+        f"[bold red]not solved[/]: mean {mean:.1f} <= 300 "
+        f"(95% interval {mean - half:.1f} to {mean + half:.1f})"
+    )
+    one = summarize([Episode(320.0)])
+    assert verdict(one) == "[bold green]solved[/]: mean 320.0 > 300"  # no spread from one
 
 
 def test_wilson_interval_known_values():
