@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .episodes import curation_keeps, curation_on
+from .schedule import actor_lowest_atoms
 
 
 def replay_kept_share(
@@ -49,7 +50,9 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         ),
         # agent.actor_cvar, once the risk-averse objective is on
         "actor_cvar": (
-            trainer.cfg.agent.actor_cvar if trainer.agent.actor_lowest_atoms is not None else None
+            trainer.cfg.agent.actor_cvar
+            if actor_lowest_atoms(trainer.step, trainer.cfg.agent) is not None
+            else None
         ),
         **trainer.last_metrics,
     }

@@ -120,7 +120,7 @@ def test_the_display_shows_the_objective_once_it_is_on(tmp_path):
 
     trainer = Trainer(config_from_dict(cvar_dict()), tmp_path / "run")
     assert trainer.snapshot(0.0)["actor_cvar"] is None  # before its step
-    trainer.agent.actor_lowest_atoms = actor_lowest_atoms(300, trainer.cfg.agent)
+    trainer.step = 300
     display = TrainingDisplay(Console(width=200, record=True))
     display.snapshot = trainer.snapshot(0.0)
     display.console.print(display.stats_table())
