@@ -162,7 +162,7 @@ def falls_text(summary: dict) -> str:
 
 
 def verdict(summary: dict) -> str:
-    """'solved: mean 309.8 > 300 (95% interval 309.0 to 310.6)': the verdict is the mean's; the
+    """'solved: mean 309.8 > 300 (95% interval 309.6 to 310.0)': the verdict is the mean's; the
     interval says how far these episodes pin the policy's expected return down."""
     from .evaluation import mean_interval
 
