@@ -5,9 +5,12 @@
         docs/runs/hardcore-confirm-session4.json docs/runs/hardcore-average-screen-session4.json
 
 Inputs are `bipedal select --json` reports (their first round and their confirmation round are
-separate blocks of env seeds). A policy is its path as the report names it (made relative to
-the working directory) and its policy step. A block of seeds is counted once per policy. Leave
-out the report that chose a policy: its block is biased in the policy's favour.
+separate blocks of env seeds). A policy is the sha256 of its file, which reports record since
+session 7. An older report's row (no sha256) is matched by its path (made relative to the
+working directory) and policy step to the one file that newer reports saw there, and stays a
+row of its own when they saw two (a new policy shipped under the same name and step). A block
+of seeds is counted once per policy. Leave out the report that chose a policy: its block is
+biased in the policy's favour.
 
 Block i has n_i episodes, mean m_i and population standard deviation s_i (`bipedal eval`'s). Over
 N = sum n_i episodes:
@@ -54,14 +57,15 @@ def wilson_interval(falls: int, total: int, z: float = Z95) -> tuple[float, floa
     return (centre - half) / scale, (centre + half) / scale
 
 
-def policy_key(path: str, step: int) -> tuple[str, int]:
-    p = Path(path)
+def place(candidate: dict) -> tuple[str, int]:
+    """(path relative to the working directory, policy step) of a report's row."""
+    p = Path(candidate["path"])
     if p.is_absolute():
         try:
             p = p.relative_to(Path.cwd())
         except ValueError:
             pass
-    return str(p), int(step)
+    return str(p), int(candidate["step"])
 
 
 def rounds(report: dict) -> list[tuple[tuple[int, int], list[dict]]]:
@@ -72,14 +76,27 @@ def rounds(report: dict) -> list[tuple[tuple[int, int], list[dict]]]:
     return out
 
 
-def collect(reports: list[dict]) -> dict[tuple[str, int], dict[tuple[int, int], dict]]:
-    """policy -> {seed block -> its held-out summary}; a block seen twice is kept once."""
-    seen: dict[tuple[str, int], dict[tuple[int, int], dict]] = defaultdict(dict)
-    for report in reports:
-        for seeds, candidates in rounds(report):
-            for c in candidates:
-                seen[policy_key(c["path"], c["step"])].setdefault(seeds, c["held_out"])
-    return seen
+def collect(reports: list[dict]) -> dict[str, dict]:
+    """policy id -> {"place": (path, step), "blocks": {seed block -> held-out summary}}; a
+    block seen twice is kept once."""
+    rows = [(seeds, c) for report in reports for seeds, cs in rounds(report) for c in cs]
+    files_at: dict[tuple[str, int], set[str]] = defaultdict(set)
+    for _, c in rows:
+        if c.get("sha256"):
+            files_at[place(c)].add(c["sha256"])
+    policies: dict[str, dict] = {}
+    for seeds, c in rows:
+        where = place(c)
+        known = files_at.get(where, set())
+        if c.get("sha256"):
+            key = c["sha256"]
+        elif len(known) == 1:
+            key = next(iter(known))
+        else:  # never recorded, or two files under one name and step: its own row
+            key = f"{where[0]}@{where[1]}" + (" (ambiguous)" if known else "")
+        entry = policies.setdefault(key, {"place": where, "blocks": {}})
+        entry["blocks"].setdefault(seeds, c["held_out"])
+    return policies
 
 
 def main() -> None:
@@ -92,9 +109,12 @@ def main() -> None:
         "| policy | step | blocks | episodes | mean return (95% interval) "
         "| falls per 100 (95% interval) |\n|---|---|---|---|---|---|"
     )
-    for (path, step), blocks in sorted(policies.items(), key=lambda kv: -len(kv[1])):
+    for key, entry in sorted(policies.items(), key=lambda kv: -len(kv[1]["blocks"])):
+        (path, step), blocks = entry["place"], entry["blocks"]
         if len(blocks) < args.min_blocks:
             continue
+        if key.endswith("(ambiguous)"):
+            path += " (rows without sha256: two files were seen here)"
         held = list(blocks.values())
         total, mean, std = pool_blocks([(h["episodes"], h["mean"], h["std"]) for h in held])
         lo, hi = mean_interval(total, mean, std)

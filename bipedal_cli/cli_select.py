@@ -129,7 +129,13 @@ def _evaluate(candidates, seeds: list[int], workers: int) -> list[dict]:
 
 def _rows(candidates, scores) -> list[dict]:
     return [
-        {"path": str(c.path), "step": c.step, "periodic": c.periodic, "held_out": s}
+        {
+            "path": str(c.path),
+            "step": c.step,
+            "sha256": c.sha256,
+            "periodic": c.periodic,
+            "held_out": s,
+        }
         for c, s in zip(candidates, scores, strict=True)
     ]
 

@@ -34,6 +34,7 @@ class Candidate:
     env: str
     periodic: float | None  # the periodic evaluation's mean at this very step, if there was one
     periodic_falls: int | None
+    sha256: str = ""  # of the file's bytes, set by ``distinct``: the policy's identity in reports
 
 
 def describe(path: Path) -> Candidate:
@@ -78,7 +79,7 @@ def distinct(candidates: list[Candidate]) -> list[Candidate]:
     seen: set[str] = set()
     out = []
     for c in candidates:
-        digest = hashlib.sha256(c.path.read_bytes()).hexdigest()
+        c.sha256 = digest = hashlib.sha256(c.path.read_bytes()).hexdigest()
         if digest not in seen:
             seen.add(digest)
             out.append(c)

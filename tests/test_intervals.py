@@ -59,26 +59,39 @@ def held(mean, falls, episodes=100):
     return {"episodes": episodes, "mean": mean, "std": 50.0, "falls": falls}
 
 
+def row(path, step, mean, sha=None, episodes=100):
+    out = {"path": str(path), "step": step, "held_out": held(mean, 10, episodes)}
+    return out if sha is None else {**out, "sha256": sha}
+
+
+def report(first, rows, confirm=None):
+    out = {"seeds": [first, first + 99], "candidates": rows, "confirm": None}
+    if confirm:
+        out["confirm"] = {"seeds": [first + 100, first + 299], "finalists": confirm}
+    return out
+
+
 def test_a_block_counts_once_and_absolute_paths_match_relative_ones():
     shipped = Path.cwd() / "checkpoints" / "p.pt"
-    first = {
-        "seeds": [10, 109],
-        "candidates": [{"path": str(shipped), "step": 5, "held_out": held(280.0, 9)}],
-        "confirm": {
-            "seeds": [110, 309],
-            "finalists": [{"path": "checkpoints/p.pt", "step": 5, "held_out": held(270, 20, 200)}],
-        },
-    }
-    again = {  # the same first block in another report, and another policy step of the path
-        "seeds": [10, 109],
-        "candidates": [
-            {"path": "checkpoints/p.pt", "step": 5, "held_out": held(999.0, 0)},
-            {"path": "checkpoints/p.pt", "step": 6, "held_out": held(250.0, 30)},
-        ],
-        "confirm": None,
-    }
+    first = report(10, [row(shipped, 5, 280.0)], confirm=[row("checkpoints/p.pt", 5, 270.0)])
+    again = report(10, [row("checkpoints/p.pt", 5, 999.0), row("checkpoints/p.pt", 6, 250.0)])
     policies = pool_heldout.collect([first, again])
-    assert set(policies) == {("checkpoints/p.pt", 5), ("checkpoints/p.pt", 6)}
-    blocks = policies[("checkpoints/p.pt", 5)]
+    places = {e["place"] for e in policies.values()}
+    assert places == {("checkpoints/p.pt", 5), ("checkpoints/p.pt", 6)}
+    (blocks,) = [e["blocks"] for e in policies.values() if e["place"][1] == 5]
     assert sorted(blocks) == [(10, 109), (110, 309)]
     assert blocks[(10, 109)]["mean"] == 280.0  # the first report's, not the repeat's
+
+
+def test_the_file_digest_is_the_identity_and_old_rows_join_the_one_file_seen_there():
+    old = report(10, [row("checkpoints/p.pt", 5, 280.0)])
+    new = report(1000, [row("checkpoints/p.pt", 5, 270.0, sha="aa")])
+    kept_copy = report(2000, [row("runs/r/policies/step-5.pt", 5, 260.0, sha="aa")])
+    policies = pool_heldout.collect([old, new, kept_copy])
+    assert list(policies) == ["aa"]  # one policy: the old row by name, the copy by content
+    assert len(policies["aa"]["blocks"]) == 3
+
+    reshipped = report(3000, [row("checkpoints/p.pt", 5, 300.0, sha="bb")])
+    policies = pool_heldout.collect([old, new, reshipped])
+    assert set(policies) == {"aa", "bb", "checkpoints/p.pt@5 (ambiguous)"}
+    assert len(policies["aa"]["blocks"]) == len(policies["bb"]["blocks"]) == 1

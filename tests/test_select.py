@@ -1,5 +1,6 @@
 """bipedal select: ranking by periodic evaluation, re-evaluation on held-out seeds."""
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -62,6 +63,8 @@ def test_select_copies_the_held_out_winner(tmp_path, kept_run, capsys):
     assert means[data["chosen"]] == max(means.values())
     chosen_step = load_checkpoint(data["chosen"])["meta"]["steps"]
     assert load_checkpoint(out)["meta"]["steps"] == chosen_step
+    for r in data["candidates"]:  # the file's identity, for pooling reports across sessions
+        assert r["sha256"] == hashlib.sha256(Path(r["path"]).read_bytes()).hexdigest()
     assert "chosen:" in stdout
     code, _, err = run_cli([*args], capsys)  # --out exists now
     assert code == 2 and "--force" in err and len(err.strip().splitlines()) == 1
