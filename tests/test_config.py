@@ -24,6 +24,7 @@ SHIPPED = {
     "hardcore-h8-curated": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
     "hardcore-h8-fallramp": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-lrdecay-cvar-late": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
 }
 
 
@@ -98,6 +99,20 @@ def test_hardcore_lrdecay_cvar_is_lrdecay_until_its_actor_turns_risk_averse():
     check_branch_config(decay, cvar, 1_100_000, "hardcore-lrdecay-cvar.yaml")
     cvar.agent.actor_cvar, cvar.agent.actor_cvar_start = None, 0
     assert cvar == decay
+
+
+def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_282():
+    """The pilot: seed 0's decaying run, branched where it stood when the key was added."""
+    from bipedal_cli.validation import check_branch_config
+
+    decay, late = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-lrdecay", "hardcore-lrdecay-cvar-late")
+    )
+    assert (late.agent.actor_cvar, late.agent.actor_cvar_start) == (0.5, 1_730_000)
+    check_branch_config(decay, late, 1_728_282, "hardcore-lrdecay-cvar-late.yaml")
+    late.agent.actor_cvar, late.agent.actor_cvar_start, late.train.keep_policies = None, 0, False
+    assert late == decay
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():
