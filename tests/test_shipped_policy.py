@@ -15,7 +15,7 @@ SHIPPED = {  # policy file: (its eval report, env, the config that trained it, s
     "bipedal_hardcore.pt": (
         "bipedal_hardcore.eval.json",
         "BipedalWalkerHardcore-v3",
-        "hardcore-lrdecay.yaml",
+        "hardcore-lrdecay-cvar-late.yaml",
         False,  # not yet: README's Hardcore section gives its score
     ),
 }
