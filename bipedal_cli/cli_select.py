@@ -73,19 +73,25 @@ def select(
     # a policy file named on the command line is always a candidate; runs give their top K
     chosen = pool[: len(named)] + top_candidates(pool[len(named) :], top or len(pool))
     seeds = list(range(seed, seed + episodes))
-    scores = _evaluate(chosen, seeds, workers)
+    scores, episodes_of = _evaluate(chosen, seeds, workers)
     best = max(range(len(chosen)), key=lambda i: scores[i]["mean"])
     console.print(_table(chosen, scores, best, seeds))
-    payload: dict = {"seeds": [seeds[0], seeds[-1]]}
+    means = [s["mean"] for s in scores]
+    pair = finalists(means, len(named))
+    # the winner against the incumbent or the runner-up (also when the incumbent won)
+    ranked = sorted(range(len(means)), key=lambda i: means[i], reverse=True)
+    shown = pair if len(pair) == 2 else ranked[:2]
+    payload: dict = {"seeds": [seeds[0], seeds[-1]], **_difference(chosen, episodes_of, shown)}
     if confirm:
-        final = [chosen[i] for i in finalists([s["mean"] for s in scores], len(named))]
+        final = [chosen[i] for i in pair]
         second = list(range(seeds[-1] + 1, seeds[-1] + 1 + confirm))
-        final_scores = _evaluate(final, second, workers)
+        final_scores, final_episodes = _evaluate(final, second, workers)
         pick = max(range(len(final)), key=lambda i: final_scores[i]["mean"])
         console.print(_table(final, final_scores, pick, second, "confirmation"))
         payload["confirm"] = {
             "seeds": [second[0], second[-1]],
             "finalists": _rows(final, final_scores),
+            **_difference(final, final_episodes, [pick, 1 - pick][: len(final)]),
         }
         winner = final[pick]
     else:
@@ -101,14 +107,15 @@ def select(
             tmp.write_text(json.dumps(payload, indent=1))
 
 
-def _evaluate(candidates, seeds: list[int], workers: int) -> list[dict]:
-    """Each candidate's summary over one episode per seed, under one progress bar."""
+def _evaluate(candidates, seeds: list[int], workers: int) -> tuple[list[dict], list[list]]:
+    """Each candidate's summary over one episode per seed, and its episodes, under one
+    progress bar."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     from .checkpoint import actor_from_checkpoint, load_checkpoint
     from .evaluation import evaluate_actor, summarize
 
-    scores = []
+    scores, episodes = [], []
     with Progress(
         "[bold]held-out", BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console
     ) as progress:
@@ -124,7 +131,31 @@ def _evaluate(candidates, seeds: list[int], workers: int) -> list[dict]:
                 on_episodes=lambda n: progress.advance(task, n),
             )
             scores.append(summarize(results, cfg.train.solved_threshold))
-    return scores
+            episodes.append(results)
+    return scores, episodes
+
+
+def _difference(candidates, episodes: list[list], pair: list[int]) -> dict:
+    """Print the round's winner against the other finalist (the incumbent, or the runner-up),
+    paired seed by seed, and return it for the JSON report; nothing when the round had one."""
+    from .evaluation import paired_difference
+
+    if len(pair) < 2:
+        return {}
+    first, second = pair
+    diff = paired_difference(episodes[first], episodes[second])
+    console.print(
+        f"{printable(candidates[first].path)} minus {printable(candidates[second].path)}: "
+        f"{diff['mean']:+.1f} (95% interval {diff['low']:+.1f} to {diff['high']:+.1f}, "
+        f"paired over {diff['episodes']} seeds)"
+    )
+    return {
+        "difference": {
+            "of": str(candidates[first].path),
+            "minus": str(candidates[second].path),
+            **diff,
+        }
+    }
 
 
 def _rows(candidates, scores) -> list[dict]:

@@ -92,7 +92,7 @@ class TrainingDisplay:
         if s.get("fall_penalty") is not None:  # train.fall_penalty_final: a ramp
             extra += ["fall penalty", _num(s["fall_penalty"], "{:.1f}")]
         if s.get("actor_cvar") is not None:  # agent.actor_cvar: the risk-averse actor
-            extra += ["actor objective", f"CVaR {s['actor_cvar']:.2f}"]
+            extra += ["actor objective", f"CVaR {s['actor_cvar']:g}"]
         if extra:
             table.add_row(*extra)
         return table
@@ -126,7 +126,7 @@ class TrainingDisplay:
                     if s.get("fall_penalty") is not None
                     else ""
                 )
-                + (f"  actor CVaR {s['actor_cvar']:.2f}" if s.get("actor_cvar") else ""),
+                + (f"  actor CVaR {s['actor_cvar']:g}" if s.get("actor_cvar") else ""),
                 soft_wrap=True,
             )
 

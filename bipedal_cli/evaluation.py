@@ -177,3 +177,18 @@ def mean_interval(episodes: int, mean: float, std: float, z: float = 1.96) -> tu
     """
     half = z * std / max(episodes - 1, 1) ** 0.5
     return mean - half, mean + half
+
+
+def paired_difference(a: list[EpisodeResult], b: list[EpisodeResult]) -> dict:
+    """Policy A's mean return minus policy B's over the same env seeds, with a 95% interval.
+
+    Both played each seed, so the interval is that of the mean of the per-seed differences
+    d_s = R_A(s) - R_B(s) (:func:`mean_interval` on them): a course that is long or hard for both
+    lowers both returns and leaves d_s alone, so the pairs tell two close policies apart with
+    no more episodes than either played.
+    """
+    if [r.seed for r in a] != [r.seed for r in b]:
+        raise ValueError("paired_difference: the two policies played different seeds")
+    d = np.array([x.ret - y.ret for x, y in zip(a, b, strict=True)])  # (S,)
+    low, high = mean_interval(len(d), float(d.mean()), float(d.std()))
+    return {"episodes": len(d), "mean": float(d.mean()), "low": low, "high": high}

@@ -124,4 +124,4 @@ def test_the_display_shows_the_objective_once_it_is_on(tmp_path):
     display = TrainingDisplay(Console(width=200, record=True))
     display.snapshot = trainer.snapshot(0.0)
     display.console.print(display.stats_table())
-    assert "actor objective  CVaR 0.40" in display.console.export_text()
+    assert "actor objective  CVaR 0.4 " in display.console.export_text()

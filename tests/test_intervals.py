@@ -48,6 +48,22 @@ def test_the_eval_verdict_gives_the_interval_of_its_mean():
     assert verdict(one) == "[bold green]solved[/]: mean 320.0 > 300"  # no spread from one
 
 
+def test_a_paired_difference_is_the_interval_of_the_per_seed_differences():
+    from bipedal_cli.evaluation import EpisodeResult, paired_difference
+
+    seeds = (7, 8, 9, 10)
+    a = [EpisodeResult(s, r, 900, r < 0) for s, r in zip(seeds, (310, -40, 300, 305), strict=True)]
+    b = [EpisodeResult(s, r, 900, r < 0) for s, r in zip(seeds, (300, 290, -60, 301), strict=True)]
+    d = np.array([10.0, -330.0, 360.0, 4.0])
+    diff = paired_difference(a, b)
+    half = 1.96 * d.std() / math.sqrt(3)
+    assert diff == pytest.approx(
+        {"episodes": 4, "mean": d.mean(), "low": d.mean() - half, "high": d.mean() + half}
+    )
+    with pytest.raises(ValueError, match="different seeds"):
+        paired_difference(a, b[::-1])
+
+
 def test_wilson_interval_known_values():
     lo, hi = pool_heldout.wilson_interval(10, 100)  # textbook: 5.52% - 17.44%
     assert (lo, hi) == (pytest.approx(0.0552, abs=1e-4), pytest.approx(0.1744, abs=1e-4))

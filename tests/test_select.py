@@ -119,5 +119,12 @@ def test_confirm_plays_the_finalists_on_the_next_seeds(tmp_path, kept_run, capsy
     assert data["chosen"] == max(final, key=final.get)
     assert all(r["held_out"]["episodes"] == 3 for r in data["confirm"]["finalists"])
     assert "confirmation: env seeds 2000002..2000004" in stdout
+    # each round reports its winner minus the other finalist, paired over the round's seeds
+    diff = data["confirm"]["difference"]
+    assert diff["of"] == data["chosen"] and diff["minus"] in final and diff["episodes"] == 3
+    assert diff["mean"] == pytest.approx(final[diff["of"]] - final[diff["minus"]], abs=1e-9)
+    assert diff["low"] <= diff["mean"] <= diff["high"]
+    assert data["difference"]["of"] == max(first, key=first.get)
+    assert "paired over 3 seeds" in stdout and "paired over 2 seeds" in stdout
     code, _, err = run_cli(["select", kept_run, "--confirm", -1], capsys)
     assert code == 2 and "--confirm" in err and len(err.strip().splitlines()) == 1
