@@ -78,6 +78,8 @@ class TQCAgent:
         self.updates = 0
         # the actor's objective: the mean of all atoms (None) or of the lowest L (schedule.py)
         self.actor_lowest_atoms: int | None = None
+        # agent.actor_update_start: while True, updates move the critics only (schedule.py)
+        self.actor_frozen = False
         self._online = list(self.critic.parameters())
         self._target = list(self.critic_target.parameters())
 
@@ -260,6 +262,10 @@ class TQCAgent:
         }
 
     def _actor_step(self) -> None:
+        """Adam on the actor and the temperature; skipped while :attr:`actor_frozen` (their
+        gradients are still taken: the metrics report the fixed actor's loss and entropy)."""
+        if self.actor_frozen:
+            return
         self.actor_opt.step()
         self.alpha_opt.step()
 

@@ -8,6 +8,7 @@ kill at any moment leaves the previous checkpoint intact.
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -148,6 +149,43 @@ def check_dims(data: dict[str, Any], obs_dim: int, act_dim: int, env_id: str, op
             f"{option} {data.get('path')}: policy is for observations of size {data['obs_dim']} "
             f"and actions of size {data['act_dim']}; {env_id} has {obs_dim} and {act_dim}"
         )
+
+
+# the agent keys that make two actors the same function of the same inputs
+POLICY_SHAPE_KEYS = (
+    "action_repeat",
+    "history",
+    "actor_hidden",
+    "n_layers",
+    "d2rl",
+    "log_std_min",
+    "log_std_max",
+)
+
+
+def initial_actor_state(cfg: Any, obs_dim: int, act_dim: int) -> dict[str, torch.Tensor]:
+    """The actor weights a new run starts from, ``train.init_policy``'s: a policy file (or a
+    ``state.pt``) whose bytes match ``train.init_policy_sha256`` when that is set, for the same
+    observation and action sizes, and whose actor has this config's shape and inputs
+    (:data:`POLICY_SHAPE_KEYS`). Every mismatch is one line naming the file."""
+    option, path = "train.init_policy", Path(cfg.train.init_policy)
+    data = load_checkpoint(path, option)  # a readable, well-formed checkpoint first
+    want = cfg.train.init_policy_sha256
+    if want is not None:
+        got = hashlib.sha256(Path(data["path"]).read_bytes()).hexdigest()
+        if got != want:
+            raise UserError(
+                f"{option} {path}: its sha256 is {got}, train.init_policy_sha256 expects {want}"
+            )
+    theirs = data["config"]["agent"]
+    for key in POLICY_SHAPE_KEYS:
+        if theirs[key] != getattr(cfg.agent, key):
+            raise UserError(
+                f"{option} {path}: its agent.{key} is {theirs[key]!r}, this config's is "
+                f"{getattr(cfg.agent, key)!r}; expected a policy of the same shape and inputs"
+            )
+    check_dims(data, obs_dim, act_dim, cfg.env, option)
+    return data["actor"] if data["format"] == POLICY_FORMAT else data["agent"]["actor"]
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:

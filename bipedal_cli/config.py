@@ -94,6 +94,10 @@ class AgentConfig:
     lower tail more. None: eq. 2 throughout."""
     actor_cvar_start: int = 0
     """Policy step after which the actor's objective is ``actor_cvar``'s (the mean up to it)."""
+    actor_update_start: int = 0
+    """Policy step after which the actor and the temperature learn; up to it only the critics do,
+    learning the value of a fixed actor (a run from ``train.init_policy`` warms its new critics
+    up this way). 0: all three from the first update."""
 
 
 @dataclass
@@ -104,7 +108,8 @@ class TrainConfig:
     """Policy steps to train for (``--steps`` overrides); each is ``agent.action_repeat`` env
     steps, so without action repeat these are env steps."""
     warmup_steps: int = 1000
-    """Random-action steps before learning starts (Table 1's 'learning starts')."""
+    """Random-action steps before learning starts (Table 1's 'learning starts'); with
+    ``init_policy``, that actor's own sampled actions instead."""
     buffer_size: int = 1_000_000
     """Replay buffer capacity in transitions."""
     updates_per_step: int = 1
@@ -153,6 +158,13 @@ class TrainConfig:
     """Policy step where it reaches ``fall_penalty_final`` (episodes from there on see that)."""
     reward_scale: float = 1.0
     """Training only: the learner's rewards (fall penalty included) are multiplied by this."""
+    init_policy: str | None = None
+    """A policy file whose actor a new run starts from, instead of a random one (critics,
+    temperature and replay start afresh). Its action repeat, history and actor shape must be
+    this config's. Read once, when the run starts: a resume does not need it. null: random."""
+    init_policy_sha256: str | None = None
+    """The sha256 of ``init_policy``'s bytes, checked when the run starts, so that a config
+    names one file's content, not whatever lies at that path. null: not checked."""
 
 
 @dataclass

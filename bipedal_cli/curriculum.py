@@ -14,9 +14,11 @@ from pathlib import Path
 from typing import Any
 
 from .config import ENV_ALIASES, Config
+from .envs import policy_dims
+from .errors import UserError
 from .reporting import Reporter
 from .rundir import default_run_dir, lock_run_dir, prepare_new_run_dir
-from .train import Trainer, TrainResult
+from .train import Trainer, TrainResult, new_trainer
 
 STAGES = (ENV_ALIASES["walker"], ENV_ALIASES["hardcore"])
 
@@ -47,7 +49,7 @@ def new_curriculum_trainer(
     """A trainer in a new run directory, at stage 1 (BipedalWalker-v3) of the curriculum."""
     cfg.env = STAGES[0]
     run_dir = prepare_new_run_dir(run_dir or default_run_dir(cfg, "curriculum"))
-    trainer = Trainer(cfg, run_dir, reporter)
+    trainer = new_trainer(cfg, run_dir, reporter)
     trainer.curriculum = {"stage": 0, "stage_start": _counters(trainer), "finished": []}
     return trainer
 
@@ -58,6 +60,23 @@ def start_curriculum(
     run_dir = prepare_new_run_dir(run_dir or default_run_dir(cfg, "curriculum"))
     with lock_run_dir(run_dir):
         return continue_curriculum(new_curriculum_trainer(cfg, run_dir, reporter))
+
+
+def switch_env(trainer: Trainer, env_id: str, clear_buffer: bool) -> None:
+    """Continue ``trainer`` on another env with the same networks, optimizers and temperature.
+
+    The episode in progress is dropped (it is not counted); evaluations now use ``env_id``.
+    """
+    trainer.cfg.env = env_id
+    dims = policy_dims(env_id, trainer.cfg.agent)
+    if dims != (trainer.obs_dim, trainer.act_dim):
+        raise UserError(f"{env_id}: observation/action sizes {dims} differ from the agent's")
+    if clear_buffer:
+        trainer.buffer.size = trainer.buffer.pos = 0
+    trainer.last_eval = trainer.full_eval = None
+    trainer.recent_returns.clear()
+    trainer.recent_falls.clear()
+    trainer.start_episode()
 
 
 def _counters(trainer: Trainer) -> dict[str, float]:
@@ -82,7 +101,7 @@ def continue_curriculum(trainer: Trainer) -> CurriculumResult:
         stopped = result.stopped
         state["stage"] = stage + 1
         if state["stage"] < len(STAGES):
-            trainer.switch_env(STAGES[state["stage"]], clear_buffer=c.replay == "clear")
+            switch_env(trainer, STAGES[state["stage"]], clear_buffer=c.replay == "clear")
             state["stage_start"] = _counters(trainer)
         trainer.save()
     return CurriculumResult(trainer.run_dir, list(state["finished"]), stopped)

@@ -1,5 +1,6 @@
 """Schedules over policy steps: constant, or linear over a window, for the learning rate and the
-fall penalty the learner sees; from a step on, for the actor's risk-averse objective.
+fall penalty the learner sees; from a step on, for the actor's risk-averse objective and for
+the actor's learning at all.
 
 rl-zoo's tuned TQC for BipedalWalkerHardcore-v3 decays its learning rate linearly over the run;
 ours is constant unless ``agent.lr_final`` is set. The fall penalty is constant unless
@@ -58,6 +59,13 @@ def actor_lowest_atoms(step: int, agent_cfg: Any) -> int | None:
     if a.actor_cvar is None or step <= a.actor_cvar_start:
         return None
     return max(1, math.floor(a.actor_cvar * a.n_critics * a.n_quantiles + 0.5))
+
+
+def actor_frozen(step: int, agent_cfg: Any) -> bool:
+    """Whether the update after policy step ``step`` leaves the actor and the temperature as they
+    are (only the critics learn): t <= agent.actor_update_start, and never when it is 0."""
+    start = agent_cfg.actor_update_start
+    return start > 0 and step <= start
 
 
 def fall_penalty_at(step: int, train_cfg: Any) -> float | None:

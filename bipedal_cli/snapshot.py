@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from .episodes import curation_keeps, curation_on
-from .schedule import actor_lowest_atoms
+from .schedule import actor_frozen, actor_lowest_atoms
 
 
 def replay_kept_share(
@@ -31,7 +31,13 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
     last_eval = trainer.last_eval
     curating = curation_on(t, trainer.step)
     return {
-        "phase": "warm-up" if trainer.step < t.warmup_steps else "training",
+        "phase": (
+            "warm-up"
+            if trainer.step < t.warmup_steps
+            else "critics only"  # agent.actor_update_start: the actor and alpha wait
+            if actor_frozen(trainer.step, trainer.cfg.agent)
+            else "training"
+        ),
         "step": trainer.step,
         "episodes": trainer.episodes,
         "steps_per_s": steps_per_s,

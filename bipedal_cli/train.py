@@ -27,7 +27,7 @@ import torch
 
 from .agent import TQCAgent
 from .buffer import ReplayBuffer
-from .checkpoint import POLICY_FILE, STATE_FILE, atomic_save
+from .checkpoint import POLICY_FILE, STATE_FILE, atomic_save, initial_actor_state
 from .config import Config
 from .devices import configure_threads, resolve_device
 from .envs import policy_dims
@@ -45,7 +45,7 @@ from .rundir import (
     write_config,
     write_plot,
 )
-from .schedule import actor_lowest_atoms, fall_penalty_at, scheduled_learning_rate
+from .schedule import actor_frozen, actor_lowest_atoms, fall_penalty_at, scheduled_learning_rate
 from .signals import stop_on_signals
 from .snapshot import training_snapshot
 
@@ -178,7 +178,7 @@ class Trainer:
         rate_t, rate_step = session_start, self.step
         steps_per_s = 0.0
         if self.runner.obs is None:
-            self._start_episode()
+            self.start_episode()
         try:
             while self.step < total:
                 if self._stop_signal is not None:
@@ -190,6 +190,7 @@ class Trainer:
                     if lr is not None:
                         self.agent.set_learning_rate(lr)
                     self.agent.actor_lowest_atoms = actor_lowest_atoms(self.step, cfg.agent)
+                    self.agent.actor_frozen = actor_frozen(self.step, cfg.agent)
                     for _ in range(t.updates_per_step):
                         batch = self.agent.batch_to_tensors(
                             self.buffer.sample(cfg.agent.batch_size, self.rng)
@@ -217,29 +218,14 @@ class Trainer:
         """``learning_curve.png`` in the run directory (skipped before the first episode ends)."""
         return write_plot(self.run_dir) if self.episodes else None
 
-    def switch_env(self, env_id: str, clear_buffer: bool) -> None:
-        """Continue on another env with the same networks, optimizers and temperature.
-
-        The episode in progress is dropped (it is not counted); evaluations now use ``env_id``.
-        """
-        self.cfg.env = env_id
-        dims = policy_dims(env_id, self.cfg.agent)
-        if dims != (self.obs_dim, self.act_dim):
-            raise UserError(f"{env_id}: observation/action sizes {dims} differ from the agent's")
-        if clear_buffer:
-            self.buffer.size = self.buffer.pos = 0
-        self.last_eval = self.full_eval = None
-        self.recent_returns.clear()
-        self.recent_falls.clear()
-        self._start_episode()
-
-    def _start_episode(self) -> None:
+    def start_episode(self) -> None:
         t = self.cfg.train
         seed = int(self.rng.integers(2**31 - 1))
         self.runner.start(seed, curation_on(t, self.step), fall_penalty_at(self.step, t))
 
     def _env_step(self, metrics: MetricsWriter, wall_base: float, session_start: float) -> None:
-        if self.step < self.cfg.train.warmup_steps:
+        t = self.cfg.train
+        if self.step < t.warmup_steps and t.init_policy is None:
             action = self.rng.uniform(-1.0, 1.0, self.act_dim).astype(np.float32)
         else:
             action = self.agent.act(self.runner.obs)
@@ -269,7 +255,7 @@ class Trainer:
             **self._loss_metrics(),
         }
         metrics.write(row)
-        self._start_episode()
+        self.start_episode()
 
     def _loss_metrics(self) -> dict[str, float]:
         m = self._update_metrics
@@ -304,5 +290,14 @@ def train(
     run_dir = prepare_new_run_dir(run_dir or default_run_dir(cfg))
     with lock_run_dir(run_dir):
         prepare_new_run_dir(run_dir)  # again, now that no other process can start one there
-        trainer = Trainer(cfg, run_dir, reporter)
-        return trainer.run(until_solved=until_solved)
+        return new_trainer(cfg, run_dir, reporter).run(until_solved=until_solved)
+
+
+def new_trainer(cfg: Config, run_dir: Path, reporter: Reporter | None = None) -> Trainer:
+    """The trainer of a new run; with ``train.init_policy`` its actor starts as that policy's
+    (:func:`~bipedal_cli.checkpoint.initial_actor_state`; a resumed run has its own)."""
+    trainer = Trainer(cfg, run_dir, reporter)
+    if cfg.train.init_policy is not None:
+        actor = initial_actor_state(cfg, trainer.obs_dim, trainer.act_dim)
+        trainer.agent.actor.load_state_dict(actor)
+    return trainer

@@ -8,6 +8,7 @@ key before anything is built or written.
 from __future__ import annotations
 
 import os
+import re
 from typing import Any
 
 from .errors import UserError
@@ -89,6 +90,18 @@ def validate(cfg: Any, source: str) -> None:
             "null or a number in (0, 1]",
         ),
         (a.actor_cvar_start >= 0, "agent.actor_cvar_start", "a non-negative step"),
+        (a.actor_update_start >= 0, "agent.actor_update_start", "a non-negative step"),
+        (t.init_policy != "", "train.init_policy", "null or the path of a policy file"),
+        (
+            t.init_policy_sha256 is None or re.fullmatch("[0-9a-f]{64}", t.init_policy_sha256),
+            "train.init_policy_sha256",
+            "null or 64 lowercase hex digits (sha256sum's output)",
+        ),
+        (
+            t.init_policy_sha256 is None or t.init_policy is not None,
+            "train.init_policy_sha256",
+            "null unless train.init_policy is set",
+        ),
         (t.replay_curation_start >= 0, "train.replay_curation_start", "a non-negative integer"),
         (
             a.lr_final is None or a.lr_decay_end > a.lr_decay_start,

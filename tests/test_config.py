@@ -25,6 +25,8 @@ SHIPPED = {
     "hardcore-h8-fallramp": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar-late": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-cvar": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-cvar-g99": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
 }
 
 
@@ -113,6 +115,42 @@ def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_2
     check_branch_config(decay, late, 1_728_282, "hardcore-lrdecay-cvar-late.yaml")
     late.agent.actor_cvar, late.agent.actor_cvar_start, late.train.keep_policies = None, 0, False
     assert late == decay
+
+
+@pytest.mark.parametrize(
+    "name,gamma", [("hardcore-warm-cvar", 0.98), ("hardcore-warm-cvar-g99", 0.99)]
+)
+def test_hardcore_warm_configs_are_lrdecay_from_the_committed_parent(name, gamma):
+    """A new run from the shipped-until-session-9 policy: its parent file is committed and is the
+    one the config pins; the rest is hardcore-lrdecay.yaml but for the schedule its comments
+    give and the gamma of its name."""
+    import hashlib
+
+    from bipedal_cli.checkpoint import initial_actor_state
+
+    decay, warm = (resolve_config(CONFIGS / f"{n}.yaml") for n in ("hardcore-lrdecay", name))
+    a, t = warm.agent, warm.train
+    root = CONFIGS.parent
+    assert hashlib.sha256((root / t.init_policy).read_bytes()).hexdigest() == t.init_policy_sha256
+    t.init_policy = str(root / t.init_policy)
+    assert initial_actor_state(warm, 96, 4)  # it fits this config
+    assert (a.gamma, a.lr_decay_start, a.lr_decay_end, a.actor_update_start) == (
+        gamma,
+        30_000,
+        60_000,
+        60_000,
+    )
+    assert (a.actor_cvar, a.actor_cvar_start, a.init_alpha, t.total_steps) == (
+        0.25,
+        0,
+        0.137,
+        1_000_000,
+    )
+    a.gamma, a.lr_decay_start, a.lr_decay_end, a.actor_update_start = 0.98, 1_100_000, 1_700_000, 0
+    a.actor_cvar, a.init_alpha, t.total_steps = None, 1.0, 3_000_000
+    t.init_policy = t.init_policy_sha256 = None
+    t.keep_policies = False
+    assert warm == decay
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():

@@ -127,7 +127,7 @@ def test_the_display_shows_the_penalty_of_the_episode_in_progress(tmp_path):
 
     trainer = Trainer(config_from_dict(ramped()), tmp_path / "run")
     trainer.step = 125
-    trainer._start_episode()
+    trainer.start_episode()
     display = TrainingDisplay(Console(width=200, record=True))
     display.snapshot = trainer.snapshot(0.0)
     display.console.print(display.stats_table())

@@ -82,7 +82,7 @@ def test_the_loop_stores_terminated_only_at_falls_never_at_time_limits(monkeypat
 
     monkeypatch.setattr("bipedal_cli.episodes.make_env", fake_make_env)
     trainer = Trainer(config_from_dict(tiny_dict(total_steps=120, warmup_steps=200)), "unused")
-    trainer._start_episode()
+    trainer.start_episode()
     for _ in range(120):
         trainer._env_step(_NoMetrics(), 0.0, 0.0)
     stored = trainer.buffer.terminated[: len(steps_seen)].tolist()
