@@ -87,13 +87,14 @@ def main() -> None:
     )
     print("|---|---|---|---|---|---|---|---|")
     for path, name, e in zip(args.runs, names, evals, strict=True):
-        if not e:
-            print(f"| {name} | 0 | - | - | - | - | - | - |")
+        count, mean_return, fell = training_episodes(path, args.first, args.last)
+        if not e:  # no evaluation in the window: its training episodes still tell
+            episodes = f"{count:,}, {mean_return:.1f}, {fell:.0%}" if count else "-"
+            print(f"| {name} | 0 | - | - | - | - | - | {episodes} |")
             continue
         means = [m for m, _ in e.values()]
         best = max(e, key=lambda s: e[s][0])
         tests = evaluations(path, args.first, "full_eval", args.last)
-        count, mean_return, fell = training_episodes(path, args.first, args.last)
         test_text = ", ".join(f"{m:.1f} ({f} falls) at {s:,}" for s, (m, f) in tests.items())
         print(
             f"| {name} | {len(e)} | {statistics.mean(means):.1f} | "

@@ -11,7 +11,13 @@ import numpy as np
 import torch
 
 from .config import AgentConfig
-from .losses import actor_loss, quantile_huber_loss, temperature_loss, truncated_target
+from .losses import (
+    actor_loss,
+    anchor_loss,
+    quantile_huber_loss,
+    temperature_loss,
+    truncated_target,
+)
 from .networks import QuantileCritics, SquashedGaussianActor
 
 
@@ -80,8 +86,14 @@ class TQCAgent:
         self.actor_lowest_atoms: int | None = None
         # agent.actor_update_start: while True, updates move the critics only (schedule.py)
         self.actor_frozen = False
+        # agent.actor_anchor: a frozen copy of the actor a run started from (set_anchor)
+        self.anchor: SquashedGaussianActor | None = None
         self._online = list(self.critic.parameters())
         self._target = list(self.critic_target.parameters())
+
+    def set_anchor(self) -> None:
+        """Freeze a copy of the actor as it is now: ``agent.actor_anchor``'s mu0."""
+        self.anchor = copy.deepcopy(self.actor).requires_grad_(False)
 
     def start_worker(self, flush_denormal: bool = True) -> None:
         """Run the critics' part of every update on a second thread (CPU, 2+ cores).
@@ -250,6 +262,12 @@ class TQCAgent:
         new_action, log_prob = self.actor.sample(obs, eps=eps)  # (B, A), (B,)
         new_atoms = self.critic(obs, new_action, detach_params=True)  # (B, N, M)
         pi_loss = actor_loss(log_prob, new_atoms, alpha, self.actor_lowest_atoms)
+        if self.anchor is not None and self.cfg.actor_anchor is not None:
+            with torch.no_grad():
+                mu0 = self.anchor.deterministic(obs)  # (B, A)
+            pi_loss = pi_loss + self.cfg.actor_anchor * anchor_loss(
+                self.actor.deterministic(obs), mu0
+            )
         self.actor_opt.zero_grad(set_to_none=True)
         pi_loss.backward()
         alpha_loss = temperature_loss(self.log_alpha, log_prob, self.target_entropy)
@@ -262,12 +280,22 @@ class TQCAgent:
         }
 
     def _actor_step(self) -> None:
-        """Adam on the actor and the temperature; skipped while :attr:`actor_frozen` (their
-        gradients are still taken: the metrics report the fixed actor's loss and entropy)."""
-        if self.actor_frozen:
-            return
-        self.actor_opt.step()
-        self.alpha_opt.step()
+        """Adam on the actor and the temperature. While :attr:`actor_frozen` the step has size
+        zero: theta <- theta - 0 * m_hat / (sqrt(v_hat) + eps) leaves every parameter as it is,
+        while Adam's moments m and v average the gradients. A fresh Adam's first steps are
+        about lr * sign(gradient) on every weight at once, which wrecked a trained actor within
+        50 updates (docs/hardcore.md, session 9); with warm moments a noisy gradient moves it
+        by a fraction of that."""
+        for opt in (self.actor_opt, self.alpha_opt):
+            if not self.actor_frozen:
+                opt.step()
+                continue
+            rates = [group["lr"] for group in opt.param_groups]
+            for group in opt.param_groups:
+                group["lr"] = 0.0
+            opt.step()
+            for group, lr in zip(opt.param_groups, rates, strict=True):
+                group["lr"] = lr
 
     # ------------------------------------------------------------- persistence
     def state_dict(self) -> dict:
@@ -282,6 +310,7 @@ class TQCAgent:
             "alpha_opt": self.alpha_opt.state_dict(),
             "noise_rng": self.noise.get_state(),
             "updates": self.updates,
+            "anchor": None if self.anchor is None else self.anchor.state_dict(),
         }
 
     def load_state_dict(self, state: dict) -> None:
@@ -296,3 +325,7 @@ class TQCAgent:
         self.alpha_opt.load_state_dict(state["alpha_opt"])
         self.noise.set_state(state["noise_rng"])
         self.updates = int(state["updates"])
+        self.anchor = None
+        if state.get("anchor") is not None:  # agent.actor_anchor (older states have no key)
+            self.set_anchor()
+            self.anchor.load_state_dict(state["anchor"])

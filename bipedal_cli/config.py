@@ -94,6 +94,11 @@ class AgentConfig:
     lower tail more. None: eq. 2 throughout."""
     actor_cvar_start: int = 0
     """Policy step after which the actor's objective is ``actor_cvar``'s (the mean up to it)."""
+    actor_anchor: float | None = None
+    """beta: with ``train.init_policy``, the actor's loss adds beta E_s ||mu(s) - mu0(s)||^2,
+    the squared distance of its deterministic action from the initial policy's on the batch's
+    states, so that it moves where new critics agree and stays where they are still wrong
+    (TD3+BC's term). None: off."""
     actor_update_start: int = 0
     """Policy step after which the actor and the temperature learn; up to it only the critics do,
     learning the value of a fixed actor (a run from ``train.init_policy`` warms its new critics

@@ -221,6 +221,18 @@ def actor_loss(
     return (alpha * log_prob - value).mean()
 
 
+def anchor_loss(action: torch.Tensor, anchor_action: torch.Tensor) -> torch.Tensor:
+    """The actor's distance from the policy a run started from (``agent.actor_anchor``):
+
+        J_anchor = E_s[ sum_i (mu_i(s) - mu0_i(s))^2 ]
+
+    mu(s) = tanh(mean) is the actor's deterministic action and mu0(s) the initial actor's, a
+    constant; action, anchor_action: (B, A). TD3+BC's term, with the initial policy in place of
+    the data's actions.
+    """
+    return (action - anchor_action.detach()).pow(2).sum(-1).mean()
+
+
 def temperature_loss(log_alpha: torch.Tensor, log_prob: torch.Tensor, target_entropy: float):
     """Eq. (3): J(alpha) = E[log alpha * (-log pi(a|s) - H_T)].
 

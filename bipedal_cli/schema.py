@@ -88,6 +88,8 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
         _check_weights(
             _get(agent, net, Mapping, where, "agent."), shapes[net], where, f"agent.{net}"
         )
+    if agent.get("anchor") is not None:  # agent.actor_anchor's initial actor
+        _check_weights(agent["anchor"], shapes["actor"], where, "agent.anchor")
     log_alpha = _get(agent, "log_alpha", torch.Tensor, where, "agent.")
     if log_alpha.numel() != 1 or not bool(torch.isfinite(log_alpha).all()):
         raise _fail(where, "agent.log_alpha", "should be one finite number")

@@ -300,4 +300,6 @@ def new_trainer(cfg: Config, run_dir: Path, reporter: Reporter | None = None) ->
     if cfg.train.init_policy is not None:
         actor = initial_actor_state(cfg, trainer.obs_dim, trainer.act_dim)
         trainer.agent.actor.load_state_dict(actor)
+        if cfg.agent.actor_anchor is not None:
+            trainer.agent.set_anchor()
     return trainer

@@ -91,6 +91,11 @@ def validate(cfg: Any, source: str) -> None:
         ),
         (a.actor_cvar_start >= 0, "agent.actor_cvar_start", "a non-negative step"),
         (a.actor_update_start >= 0, "agent.actor_update_start", "a non-negative step"),
+        (
+            a.actor_anchor is None or (a.actor_anchor > 0 and t.init_policy is not None),
+            "agent.actor_anchor",
+            "null, or a positive number with train.init_policy set (the actor it anchors to)",
+        ),
         (t.init_policy != "", "train.init_policy", "null or the path of a policy file"),
         (
             t.init_policy_sha256 is None or re.fullmatch("[0-9a-f]{64}", t.init_policy_sha256),

@@ -76,6 +76,16 @@ def ref_actor_cvar_loss(log_prob, atoms, alpha, lowest):
     return total / B
 
 
+def ref_anchor_loss(action, anchor_action):
+    """E_s[ sum_i (mu_i(s) - mu0_i(s))^2 ], mu0 a constant (agent.actor_anchor)."""
+    B, A = action.shape
+    total = 0.0
+    for b in range(B):
+        for i in range(A):
+            total = total + (action[b, i] - anchor_action[b, i].item()) ** 2
+    return total / B
+
+
 def ref_temperature_loss(log_alpha, log_prob, target_entropy):
     B = log_prob.shape[0]
     total = 0.0

@@ -25,8 +25,8 @@ SHIPPED = {
     "hardcore-h8-fallramp": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar-late": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
-    "hardcore-warm-cvar": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
-    "hardcore-warm-cvar-g99": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-anchor100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-anchor25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
 }
 
 
@@ -118,12 +118,12 @@ def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_2
 
 
 @pytest.mark.parametrize(
-    "name,gamma", [("hardcore-warm-cvar", 0.98), ("hardcore-warm-cvar-g99", 0.99)]
+    "name,anchor", [("hardcore-warm-anchor100", 100.0), ("hardcore-warm-anchor25", 25.0)]
 )
-def test_hardcore_warm_configs_are_lrdecay_from_the_committed_parent(name, gamma):
+def test_hardcore_warm_configs_are_lrdecay_from_the_committed_parent(name, anchor):
     """A new run from the shipped-until-session-9 policy: its parent file is committed and is the
     one the config pins; the rest is hardcore-lrdecay.yaml but for the schedule its comments
-    give and the gamma of its name."""
+    give and the anchor of its name."""
     import hashlib
 
     from bipedal_cli.checkpoint import initial_actor_state
@@ -134,8 +134,8 @@ def test_hardcore_warm_configs_are_lrdecay_from_the_committed_parent(name, gamma
     assert hashlib.sha256((root / t.init_policy).read_bytes()).hexdigest() == t.init_policy_sha256
     t.init_policy = str(root / t.init_policy)
     assert initial_actor_state(warm, 96, 4)  # it fits this config
-    assert (a.gamma, a.lr_decay_start, a.lr_decay_end, a.actor_update_start) == (
-        gamma,
+    assert (a.actor_anchor, a.lr_decay_start, a.lr_decay_end, a.actor_update_start) == (
+        anchor,
         30_000,
         60_000,
         60_000,
@@ -146,7 +146,12 @@ def test_hardcore_warm_configs_are_lrdecay_from_the_committed_parent(name, gamma
         0.137,
         1_000_000,
     )
-    a.gamma, a.lr_decay_start, a.lr_decay_end, a.actor_update_start = 0.98, 1_100_000, 1_700_000, 0
+    a.actor_anchor, a.lr_decay_start, a.lr_decay_end, a.actor_update_start = (
+        None,
+        1_100_000,
+        1_700_000,
+        0,
+    )
     a.actor_cvar, a.init_alpha, t.total_steps = None, 1.0, 3_000_000
     t.init_policy = t.init_policy_sha256 = None
     t.keep_policies = False

@@ -166,3 +166,21 @@ def test_count_below_matches_searchsorted_left_and_right(K):
     strict, weak = count_below(y, q, w)
     assert torch.equal(strict, torch.searchsorted(y, q, side="left"))
     assert torch.equal(weak, torch.searchsorted(y, w, side="right"))
+
+
+def test_anchor_loss_matches_reference_value_and_gradient():
+    from bipedal_cli.losses import anchor_loss
+
+    from .reference import ref_anchor_loss
+
+    gen = torch.Generator().manual_seed(11)
+    action = torch.rand(5, 4, dtype=torch.float64, generator=gen).mul(2).sub(1).requires_grad_()
+    anchor = torch.rand(5, 4, dtype=torch.float64, generator=gen).mul(2).sub(1).requires_grad_()
+    got, want = anchor_loss(action, anchor), ref_anchor_loss(action, anchor)
+    assert got.item() == pytest.approx(want.item(), rel=1e-12)
+    (g_got,) = torch.autograd.grad(got, action)
+    (g_want,) = torch.autograd.grad(want, action)
+    assert torch.allclose(g_got, g_want, rtol=1e-12, atol=0)
+    assert torch.allclose(g_got, 2 * (action - anchor).detach() / 5, rtol=1e-12)
+    assert anchor_loss(action, anchor).grad_fn is not None
+    assert not torch.autograd.grad(anchor_loss(action, anchor), anchor, allow_unused=True)[0]

@@ -56,6 +56,9 @@ def test_a_run_starts_from_the_policy_and_only_its_critics_learn_until_the_step(
     assert state["agent"]["updates"] == 150  # the critics learned ...
     assert actors_equal(state["agent"]["actor"], start)  # ... the actor did not
     assert float(state["agent"]["log_alpha"].exp()) == pytest.approx(0.3)  # nor the temperature
+    # but Adam's moments did average the actor's gradients: steps of size zero
+    adam = state["agent"]["actor_opt"]["state"][0]
+    assert float(adam["step"]) == 150 and bool(adam["exp_avg_sq"].gt(0).any())
     fresh = Trainer(config_from_dict(warm_dict(parent)), tmp_path / "fresh").agent
     moved = fresh.critic.state_dict()
     assert any(not torch.equal(v, state["agent"]["critic"][k]) for k, v in moved.items())
@@ -82,7 +85,7 @@ def test_the_warm_up_acts_with_the_policy_not_at_random(tmp_path, parent):
 def test_resume_needs_no_file_and_matches_the_uninterrupted_run(tmp_path, parent):
     own = tmp_path / "parent.pt"
     shutil.copy(parent, own)
-    data = warm_dict(own, actor_update_start=200)
+    data = warm_dict(own, actor_update_start=200, actor_anchor=3.0)
     data["train"]["init_policy_sha256"] = hashlib.sha256(own.read_bytes()).hexdigest()
     straight_cfg = config_from_dict(data)
     straight_cfg.train.total_steps = 400
@@ -93,6 +96,35 @@ def test_resume_needs_no_file_and_matches_the_uninterrupted_run(tmp_path, parent
     a, b = (load_checkpoint(tmp_path / n / "state.pt") for n in ("straight", "split"))
     skip = ("/counters/wall_time", "/path", "/config/train/total_steps")
     assert_states_equal(a, b, skip=skip)
+    assert actors_equal(b["agent"]["anchor"], load_checkpoint(parent)["actor"])  # never moves
+
+
+def test_the_anchor_holds_the_actor_near_the_policy_it_started_from(tmp_path, parent):
+    start = load_checkpoint(parent)
+    cfg = config_from_dict(start["config"])
+    mu0 = make_actor(cfg.agent, 24, 4)
+    mu0.load_state_dict(start["actor"])
+
+    def drift(anchor):
+        data = warm_dict(parent, actor_update_start=100, actor_anchor=anchor)
+        data["train"]["total_steps"] = 400
+        run = train(config_from_dict(data), tmp_path / f"run-{anchor}").run_dir
+        state = load_checkpoint(run / "state.pt")
+        mu = make_actor(cfg.agent, 24, 4)
+        mu.load_state_dict(state["agent"]["actor"])
+        obs = torch.as_tensor(state["buffer"]["obs"][:250])
+        with torch.no_grad():
+            return float((mu.deterministic(obs) - mu0.deterministic(obs)).pow(2).sum(1).mean())
+
+    free, held = drift(None), drift(1000.0)
+    assert held < free / 10, (held, free)
+
+
+def test_the_anchor_needs_the_policy_it_anchors_to():
+    data = tiny_dict()
+    data["agent"]["actor_anchor"] = 10.0
+    with pytest.raises(UserError, match="agent.actor_anchor"):
+        config_from_dict(data)
 
 
 def test_a_file_that_does_not_fit_is_one_line(tmp_path, parent, capsys):
