@@ -14,6 +14,7 @@ from .config import AgentConfig
 from .losses import (
     actor_loss,
     anchor_loss,
+    kl_anchor_loss,
     quantile_huber_loss,
     temperature_loss,
     truncated_target,
@@ -25,6 +26,11 @@ def make_actor(cfg: AgentConfig, obs_dim: int, act_dim: int) -> SquashedGaussian
     return SquashedGaussianActor(
         obs_dim, act_dim, cfg.actor_hidden, cfg.n_layers, cfg.d2rl, cfg.log_std_min, cfg.log_std_max
     )
+
+
+def anchored(cfg: AgentConfig) -> bool:
+    """Whether the actor's loss pulls it towards the policy the run started from."""
+    return cfg.actor_anchor is not None or cfg.actor_anchor_kl is not None
 
 
 class _MetricsWhenDone(Mapping):
@@ -262,12 +268,8 @@ class TQCAgent:
         new_action, log_prob = self.actor.sample(obs, eps=eps)  # (B, A), (B,)
         new_atoms = self.critic(obs, new_action, detach_params=True)  # (B, N, M)
         pi_loss = actor_loss(log_prob, new_atoms, alpha, self.actor_lowest_atoms)
-        if self.anchor is not None and self.cfg.actor_anchor is not None:
-            with torch.no_grad():
-                mu0 = self.anchor.deterministic(obs)  # (B, A)
-            pi_loss = pi_loss + self.cfg.actor_anchor * anchor_loss(
-                self.actor.deterministic(obs), mu0
-            )
+        if self.anchor is not None:
+            pi_loss = pi_loss + self._anchor_penalty(obs)
         self.actor_opt.zero_grad(set_to_none=True)
         pi_loss.backward()
         alpha_loss = temperature_loss(self.log_alpha, log_prob, self.target_entropy)
@@ -278,6 +280,18 @@ class TQCAgent:
             "alpha_loss": alpha_loss.detach(),
             "entropy": -log_prob.detach().mean(),
         }
+
+    def _anchor_penalty(self, obs: torch.Tensor) -> torch.Tensor | float:
+        """beta ||mu - mu0||^2 (``actor_anchor``) + beta' KL(pi || pi0) (``actor_anchor_kl``)."""
+        cfg, penalty = self.cfg, 0.0
+        with torch.no_grad():
+            mean0, log_std0 = self.anchor.distribution_params(obs)  # (B, A) each
+        mean, log_std = self.actor.distribution_params(obs)
+        if cfg.actor_anchor is not None:
+            penalty = cfg.actor_anchor * anchor_loss(torch.tanh(mean), torch.tanh(mean0))
+        if cfg.actor_anchor_kl is not None:
+            penalty = penalty + cfg.actor_anchor_kl * kl_anchor_loss(mean, log_std, mean0, log_std0)
+        return penalty
 
     def _actor_step(self) -> None:
         """Adam on the actor and the temperature. While :attr:`actor_frozen` the step has size
@@ -329,3 +343,7 @@ class TQCAgent:
         if state.get("anchor") is not None:  # agent.actor_anchor (older states have no key)
             self.set_anchor()
             self.anchor.load_state_dict(state["anchor"])
+        elif anchored(self.cfg):
+            # a branch into the anchor, which the branch check allows only up to
+            # agent.actor_update_start: the actor is still the one the run started from
+            self.set_anchor()

@@ -99,6 +99,10 @@ class AgentConfig:
     the squared distance of its deterministic action from the initial policy's on the batch's
     states, so that it moves where new critics agree and stays where they are still wrong
     (TD3+BC's term). None: off."""
+    actor_anchor_kl: float | None = None
+    """beta: with ``train.init_policy``, the actor's loss adds beta E_s KL(pi(.|s) || pi0(.|s)),
+    its divergence from the initial policy: mean and spread, where ``actor_anchor`` holds the
+    mean action only. None: off."""
     actor_update_start: int = 0
     """Policy step after which the actor and the temperature learn; up to it only the critics do,
     learning the value of a fixed actor (a run from ``train.init_policy`` warms its new critics

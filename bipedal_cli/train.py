@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from .agent import TQCAgent
+from .agent import TQCAgent, anchored
 from .buffer import ReplayBuffer
 from .checkpoint import POLICY_FILE, STATE_FILE, atomic_save, initial_actor_state
 from .config import Config
@@ -300,6 +300,6 @@ def new_trainer(cfg: Config, run_dir: Path, reporter: Reporter | None = None) ->
     if cfg.train.init_policy is not None:
         actor = initial_actor_state(cfg, trainer.obs_dim, trainer.act_dim)
         trainer.agent.actor.load_state_dict(actor)
-        if cfg.agent.actor_anchor is not None:
+        if anchored(cfg.agent):
             trainer.agent.set_anchor()
     return trainer

@@ -96,6 +96,11 @@ def validate(cfg: Any, source: str) -> None:
             "agent.actor_anchor",
             "null, or a positive number with train.init_policy set (the actor it anchors to)",
         ),
+        (
+            a.actor_anchor_kl is None or (a.actor_anchor_kl > 0 and t.init_policy is not None),
+            "agent.actor_anchor_kl",
+            "null, or a positive number with train.init_policy set (the actor it anchors to)",
+        ),
         (t.init_policy != "", "train.init_policy", "null or the path of a policy file"),
         (
             t.init_policy_sha256 is None or re.fullmatch("[0-9a-f]{64}", t.init_policy_sha256),
@@ -201,6 +206,13 @@ DEFERRED = (
         lambda c: c.agent.actor_cvar is not None,
         lambda c: c.agent.actor_cvar_start,
     ),
+    # the anchor pulls nothing while the actor waits: it is still the anchor itself
+    (
+        ("agent.actor_anchor", "agent.actor_anchor_kl"),
+        "agent.actor_update_start",
+        lambda c: c.agent.actor_anchor is not None or c.agent.actor_anchor_kl is not None,
+        lambda c: c.agent.actor_update_start,
+    ),
 )
 
 
@@ -239,5 +251,5 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
             f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
             "change only device, train.threads, train.total_steps, train.keep_policies and "
             "features that start at or after the branch point (learning-rate decay, replay "
-            "curation, fall-penalty ramp, risk-averse actor)"
+            "curation, fall-penalty ramp, risk-averse actor, actor anchor)"
         )

@@ -86,6 +86,21 @@ def ref_anchor_loss(action, anchor_action):
     return total / B
 
 
+def ref_kl_anchor_loss(mean, log_std, mean0, log_std0):
+    """E_s[ sum_i KL(N(mu_i, sigma_i^2) || N(mu0_i, sigma0_i^2)) ], pi0 a constant."""
+    import math
+
+    B, A = mean.shape
+    total = 0.0
+    for b in range(B):
+        for i in range(A):
+            s, s0 = log_std[b, i].exp(), math.exp(log_std0[b, i].item())
+            m0 = mean0[b, i].item()
+            total = total + math.log(s0) - log_std[b, i]
+            total = total + (s**2 + (mean[b, i] - m0) ** 2) / (2 * s0**2) - 0.5
+    return total / B
+
+
 def ref_temperature_loss(log_alpha, log_prob, target_entropy):
     B = log_prob.shape[0]
     total = 0.0

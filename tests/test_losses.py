@@ -184,3 +184,27 @@ def test_anchor_loss_matches_reference_value_and_gradient():
     assert torch.allclose(g_got, 2 * (action - anchor).detach() / 5, rtol=1e-12)
     assert anchor_loss(action, anchor).grad_fn is not None
     assert not torch.autograd.grad(anchor_loss(action, anchor), anchor, allow_unused=True)[0]
+
+
+def test_kl_anchor_loss_matches_reference_value_and_gradient():
+    from bipedal_cli.losses import kl_anchor_loss
+
+    from .reference import ref_kl_anchor_loss
+
+    gen = torch.Generator().manual_seed(12)
+    mean, mean0 = (torch.randn(5, 4, dtype=torch.float64, generator=gen) for _ in range(2))
+    log_std, log_std0 = (torch.randn(5, 4, dtype=torch.float64, generator=gen) for _ in range(2))
+    mean.requires_grad_(), log_std.requires_grad_()
+    got = kl_anchor_loss(mean, log_std, mean0, log_std0)
+    want = ref_kl_anchor_loss(mean, log_std, mean0, log_std0)
+    assert got.item() == pytest.approx(want.item(), rel=1e-12)
+    g_got = torch.autograd.grad(got, (mean, log_std))
+    g_want = torch.autograd.grad(want, (mean, log_std))
+    for a, b in zip(g_got, g_want, strict=True):
+        assert torch.allclose(a, b, rtol=1e-12, atol=0)
+    normal = torch.distributions.Normal  # and torch's own KL of the two Gaussians
+    kl = torch.distributions.kl_divergence(
+        normal(mean, log_std.exp()), normal(mean0, log_std0.exp())
+    )
+    assert got.item() == pytest.approx(kl.sum(-1).mean().item(), rel=1e-12)
+    assert kl_anchor_loss(mean0, log_std0, mean0, log_std0).item() == 0.0  # zero at the anchor

@@ -105,8 +105,8 @@ def test_the_anchor_holds_the_actor_near_the_policy_it_started_from(tmp_path, pa
     mu0 = make_actor(cfg.agent, 24, 4)
     mu0.load_state_dict(start["actor"])
 
-    def drift(anchor):
-        data = warm_dict(parent, actor_update_start=100, actor_anchor=anchor)
+    def drift(**anchor):
+        data = warm_dict(parent, actor_update_start=100, **anchor)
         data["train"]["total_steps"] = 400
         run = train(config_from_dict(data), tmp_path / f"run-{anchor}").run_dir
         state = load_checkpoint(run / "state.pt")
@@ -114,10 +114,12 @@ def test_the_anchor_holds_the_actor_near_the_policy_it_started_from(tmp_path, pa
         mu.load_state_dict(state["agent"]["actor"])
         obs = torch.as_tensor(state["buffer"]["obs"][:250])
         with torch.no_grad():
-            return float((mu.deterministic(obs) - mu0.deterministic(obs)).pow(2).sum(1).mean())
+            (m, s), (m0, s0) = mu.distribution_params(obs), mu0.distribution_params(obs)
+        return float((m - m0).pow(2).sum(1).mean()), float((s - s0).pow(2).sum(1).mean())
 
-    free, held = drift(None), drift(1000.0)
-    assert held < free / 10, (held, free)
+    free, held, held_kl = drift(), drift(actor_anchor=1000.0), drift(actor_anchor_kl=1000.0)
+    assert held[0] < free[0] / 10, (held, free)  # the mean anchor holds the mean ...
+    assert held_kl[0] < free[0] / 10 and held_kl[1] < free[1] / 10, (held_kl, free)  # KL: both
 
 
 def test_the_anchor_needs_the_policy_it_anchors_to():
@@ -155,3 +157,22 @@ def test_a_checksum_without_a_file_is_refused():
     data["train"]["init_policy_sha256"] = "a" * 64
     with pytest.raises(UserError, match="null unless train.init_policy is set"):
         config_from_dict(data)
+
+
+def test_a_warm_run_branches_into_an_anchor_up_to_its_actor_update_start(tmp_path, parent):
+    """Before agent.actor_update_start the actor is the anchor itself: the anchor's term and its
+    gradient are zero, so a branch there into another anchor is that config's run."""
+    from bipedal_cli.resume import branch
+
+    plain = warm_dict(parent, actor_update_start=200)
+    plain["train"]["total_steps"] = 200
+    train(config_from_dict(plain), tmp_path / "plain")
+    anchored = warm_dict(parent, actor_update_start=200, actor_anchor=3.0)
+    anchored["train"]["total_steps"] = 320
+    branch(tmp_path / "plain", tmp_path / "branch", config_from_dict(anchored))
+    train(config_from_dict(anchored), tmp_path / "straight")
+    a, b = (load_checkpoint(tmp_path / n / "state.pt") for n in ("straight", "branch"))
+    assert_states_equal(a, b, skip=("/counters/wall_time", "/path"))
+    resume(tmp_path / "plain", total_steps=230)  # past the actor's start: no anchor now
+    with pytest.raises(UserError, match="'agent.actor_update_start' expects a step at or after"):
+        branch(tmp_path / "plain", tmp_path / "late", config_from_dict(anchored))
