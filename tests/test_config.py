@@ -27,6 +27,8 @@ SHIPPED = {
     "hardcore-lrdecay-cvar-late": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-kl100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-kl20": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
 }
 
 
@@ -156,6 +158,22 @@ def test_hardcore_warm_configs_are_lrdecay_from_the_committed_parent(name, ancho
     t.init_policy = t.init_policy_sha256 = None
     t.keep_policies = False
     assert warm == decay
+
+
+@pytest.mark.parametrize("beta", [100.0, 20.0])
+def test_hardcore_warm_kl_configs_are_branches_of_the_anchor25_run_at_its_actor_start(beta):
+    """Made as branches of hardcore-warm-anchor25.yaml's run at 60,000, where the actor starts:
+    the branch check accepts them there, and nothing but the anchor differs."""
+    from bipedal_cli.validation import check_branch_config
+
+    a25 = resolve_config(CONFIGS / "hardcore-warm-anchor25.yaml")
+    kl = resolve_config(CONFIGS / f"hardcore-warm-kl{beta:.0f}.yaml")
+    check_branch_config(a25, kl, 60_000, "kl")
+    with pytest.raises(UserError, match="actor_update_start"):
+        check_branch_config(a25, kl, 60_001, "kl")
+    assert (kl.agent.actor_anchor, kl.agent.actor_anchor_kl) == (None, beta)
+    kl.agent.actor_anchor, kl.agent.actor_anchor_kl = 25.0, None
+    assert kl == a25
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():
