@@ -6,7 +6,8 @@ does an actor climb its critics' errors after it starts learning?
 
 Per run and window of policy steps (an episode belongs to the window its last step falls in):
 the episodes, their mean env return, the share that fell, and the mean of q_mean, the critics'
-mean atom on the batch of the last update before each episode ended.
+mean atom on the batch of the last update before each episode ended, and the temperature alpha
+at the window's last episode.
 """
 
 from __future__ import annotations
@@ -41,19 +42,19 @@ def main() -> None:
     parser.add_argument("--to", dest="last", type=int, required=True)
     parser.add_argument("--every", type=int, required=True, help="window width in policy steps")
     args = parser.parse_args()
-    print("| run | policy steps | episodes | mean return | fell | mean q_mean |")
-    print("|---|---|---|---|---|---|")
+    print("| run | policy steps | episodes | mean return | fell | mean q_mean | last alpha |")
+    print("|---|---|---|---|---|---|---|")
     for path in args.runs:
         for start, end, rows in windows(path, args.first, args.last, args.every):
             if not rows:
-                print(f"| {path.name} | {start:,}-{end:,} | 0 | - | - | - |")
+                print(f"| {path.name} | {start:,}-{end:,} | 0 | - | - | - | - |")
                 continue
             ret = statistics.mean(float(r["return"]) for r in rows)
             fell = statistics.mean(int(float(r["fell"])) for r in rows)
             q = statistics.mean(float(r["q_mean"]) for r in rows)
             print(
                 f"| {path.name} | {start:,}-{end:,} | {len(rows)} | {ret:.1f} | {fell:.0%} "
-                f"| {q:.1f} |"
+                f"| {q:.1f} | {float(rows[-1]['alpha']):.2g} |"
             )
 
 
