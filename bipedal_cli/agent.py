@@ -4,21 +4,16 @@ from __future__ import annotations
 
 import copy
 import threading
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 import torch
 
+from .anchor import anchor_penalty, anchored
 from .config import AgentConfig
-from .losses import (
-    actor_loss,
-    anchor_loss,
-    kl_anchor_loss,
-    quantile_huber_loss,
-    temperature_loss,
-    truncated_target,
-)
+from .losses import actor_loss, quantile_huber_loss, temperature_loss, truncated_target
+from .metrics_when_done import MetricsWhenDone
 from .networks import QuantileCritics, SquashedGaussianActor
 
 
@@ -26,33 +21,6 @@ def make_actor(cfg: AgentConfig, obs_dim: int, act_dim: int) -> SquashedGaussian
     return SquashedGaussianActor(
         obs_dim, act_dim, cfg.actor_hidden, cfg.n_layers, cfg.d2rl, cfg.log_std_min, cfg.log_std_max
     )
-
-
-def anchored(cfg: AgentConfig) -> bool:
-    """Whether the actor's loss pulls it towards the policy the run started from."""
-    return cfg.actor_anchor is not None or cfg.actor_anchor_kl is not None
-
-
-class _MetricsWhenDone(Mapping):
-    """An update's metrics, of which the critics' arrive when the worker finishes its part."""
-
-    def __init__(self, critic_job: Future, actor_metrics: dict[str, torch.Tensor]) -> None:
-        self._job, self._actor_metrics = critic_job, actor_metrics
-        self._all: dict[str, torch.Tensor] | None = None
-
-    def _resolved(self) -> dict[str, torch.Tensor]:
-        if self._all is None:
-            self._all = {**self._job.result(), **self._actor_metrics}
-        return self._all
-
-    def __getitem__(self, key: str) -> torch.Tensor:
-        return self._resolved()[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._resolved())
-
-    def __len__(self) -> int:
-        return len(self._resolved())
 
 
 class TQCAgent:
@@ -90,10 +58,8 @@ class TQCAgent:
         self.updates = 0
         # the actor's objective: the mean of all atoms (None) or of the lowest L (schedule.py)
         self.actor_lowest_atoms: int | None = None
-        # agent.actor_update_start: while True, updates move the critics only (schedule.py)
-        self.actor_frozen = False
-        # agent.actor_anchor: a frozen copy of the actor a run started from (set_anchor)
-        self.anchor: SquashedGaussianActor | None = None
+        self.actor_frozen = False  # agent.actor_update_start: True moves the critics only
+        self.anchor: SquashedGaussianActor | None = None  # the initial actor (set_anchor)
         self._online = list(self.critic.parameters())
         self._target = list(self.critic_target.parameters())
 
@@ -203,7 +169,7 @@ class TQCAgent:
         self._critic_step_job = job
         self._actor_step()
         self.updates += 1
-        return _MetricsWhenDone(job, {**actor_metrics, "alpha": alpha})
+        return MetricsWhenDone(job, {**actor_metrics, "alpha": alpha})
 
     def _critic_part(
         self,
@@ -269,7 +235,7 @@ class TQCAgent:
         new_atoms = self.critic(obs, new_action, detach_params=True)  # (B, N, M)
         pi_loss = actor_loss(log_prob, new_atoms, alpha, self.actor_lowest_atoms)
         if self.anchor is not None:
-            pi_loss = pi_loss + self._anchor_penalty(obs)
+            pi_loss = pi_loss + anchor_penalty(self.actor, self.anchor, obs, self.cfg)
         self.actor_opt.zero_grad(set_to_none=True)
         pi_loss.backward()
         alpha_loss = temperature_loss(self.log_alpha, log_prob, self.target_entropy)
@@ -281,32 +247,14 @@ class TQCAgent:
             "entropy": -log_prob.detach().mean(),
         }
 
-    def _anchor_penalty(self, obs: torch.Tensor) -> torch.Tensor | float:
-        """beta ||mu - mu0||^2 (``actor_anchor``) + beta' KL(pi || pi0) (``actor_anchor_kl``)."""
-        cfg, penalty = self.cfg, 0.0
-        with torch.no_grad():
-            mean0, log_std0 = self.anchor.distribution_params(obs)  # (B, A) each
-        mean, log_std = self.actor.distribution_params(obs)
-        if cfg.actor_anchor is not None:
-            penalty = cfg.actor_anchor * anchor_loss(torch.tanh(mean), torch.tanh(mean0))
-        if cfg.actor_anchor_kl is not None:
-            penalty = penalty + cfg.actor_anchor_kl * kl_anchor_loss(mean, log_std, mean0, log_std0)
-        return penalty
-
     def _actor_step(self) -> None:
-        """Adam on the actor and the temperature. While :attr:`actor_frozen` the step has size
-        zero: theta <- theta - 0 * m_hat / (sqrt(v_hat) + eps) leaves every parameter as it is,
-        while Adam's moments m and v average the gradients. A fresh Adam's first steps are
-        about lr * sign(gradient) on every weight at once, which wrecked a trained actor within
-        50 updates (docs/hardcore.md, session 9); with warm moments a noisy gradient moves it
-        by a fraction of that."""
+        """Adam on the actor and the temperature; while :attr:`actor_frozen` a step of size zero,
+        theta <- theta - 0 * m_hat / (sqrt(v_hat) + eps): the parameters stay, the moments
+        average the gradients (a fresh Adam's first steps are lr * sign(g) on every weight)."""
         for opt in (self.actor_opt, self.alpha_opt):
-            if not self.actor_frozen:
-                opt.step()
-                continue
             rates = [group["lr"] for group in opt.param_groups]
             for group in opt.param_groups:
-                group["lr"] = 0.0
+                group["lr"] = 0.0 if self.actor_frozen else group["lr"]
             opt.step()
             for group, lr in zip(opt.param_groups, rates, strict=True):
                 group["lr"] = lr
@@ -340,10 +288,7 @@ class TQCAgent:
         self.noise.set_state(state["noise_rng"])
         self.updates = int(state["updates"])
         self.anchor = None
-        if state.get("anchor") is not None:  # agent.actor_anchor (older states have no key)
-            self.set_anchor()
-            self.anchor.load_state_dict(state["anchor"])
-        elif anchored(self.cfg):
-            # a branch into the anchor, which the branch check allows only up to
-            # agent.actor_update_start: the actor is still the one the run started from
-            self.set_anchor()
+        if anchored(self.cfg) or state.get("anchor") is not None:
+            self.set_anchor()  # a branch into an anchor (only up to actor_update_start) keeps it
+            if state.get("anchor") is not None:  # older states have no key
+                self.anchor.load_state_dict(state["anchor"])

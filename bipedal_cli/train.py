@@ -25,7 +25,8 @@ from typing import Any
 import numpy as np
 import torch
 
-from .agent import TQCAgent, anchored
+from .agent import TQCAgent
+from .anchor import anchored
 from .buffer import ReplayBuffer
 from .checkpoint import POLICY_FILE, STATE_FILE, atomic_save, initial_actor_state
 from .config import Config
