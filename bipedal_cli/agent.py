@@ -234,7 +234,7 @@ class TQCAgent:
         new_action, log_prob = self.actor.sample(obs, eps=eps)  # (B, A), (B,)
         new_atoms = self.critic(obs, new_action, detach_params=True)  # (B, N, M)
         pi_loss = actor_loss(log_prob, new_atoms, alpha, self.actor_lowest_atoms)
-        if self.anchor is not None:
+        if self.anchor is not None and not self.actor_frozen:  # frozen: the actor is its anchor
             pi_loss = pi_loss + anchor_penalty(self.actor, self.anchor, obs, self.cfg)
         self.actor_opt.zero_grad(set_to_none=True)
         pi_loss.backward()
@@ -252,9 +252,12 @@ class TQCAgent:
         theta <- theta - 0 * m_hat / (sqrt(v_hat) + eps): the parameters stay, the moments
         average the gradients (a fresh Adam's first steps are lr * sign(g) on every weight)."""
         for opt in (self.actor_opt, self.alpha_opt):
+            if not self.actor_frozen:
+                opt.step()
+                continue
             rates = [group["lr"] for group in opt.param_groups]
             for group in opt.param_groups:
-                group["lr"] = 0.0 if self.actor_frozen else group["lr"]
+                group["lr"] = 0.0
             opt.step()
             for group, lr in zip(opt.param_groups, rates, strict=True):
                 group["lr"] = lr
