@@ -29,6 +29,9 @@ SHIPPED = {
     "hardcore-warm-anchor25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-kl100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-kl20": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-kl100-fall25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-kl100-fall100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-warm-kl100-c10": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
 }
 
 
@@ -174,6 +177,38 @@ def test_hardcore_warm_kl_configs_are_branches_of_the_anchor25_run_at_its_actor_
     assert (kl.agent.actor_anchor, kl.agent.actor_anchor_kl) == (None, beta)
     kl.agent.actor_anchor, kl.agent.actor_anchor_kl = 25.0, None
     assert kl == a25
+
+
+@pytest.mark.parametrize("final", [25.0, 100.0])
+def test_hardcore_warm_kl100_fall_configs_are_branches_of_the_kl100_run(final):
+    """Made as branches of hardcore-warm-kl100.yaml's run at 325,163 (session 10): the branch
+    check accepts them there, not after the ramp has started, and nothing but the ramp differs."""
+    from bipedal_cli.validation import check_branch_config
+
+    kl = resolve_config(CONFIGS / "hardcore-warm-kl100.yaml")
+    ramp = resolve_config(CONFIGS / f"hardcore-warm-kl100-fall{final:.0f}.yaml")
+    check_branch_config(kl, ramp, 325_163, "fall")
+    with pytest.raises(UserError, match="fall_penalty_ramp_start"):
+        check_branch_config(kl, ramp, 326_001, "fall")
+    t = ramp.train
+    assert (t.fall_penalty_final, t.fall_penalty_ramp_start, t.fall_penalty_ramp_end) == (
+        -final,
+        326_000,
+        346_000,
+    )
+    t.fall_penalty_final, t.fall_penalty_ramp_start, t.fall_penalty_ramp_end = None, 0, 0
+    assert ramp == kl
+
+
+def test_hardcore_warm_kl100_c10_is_kl100_but_for_the_actors_objective():
+    """Session 10's run from the same parent: only the share of atoms the actor maximises."""
+    kl, c10 = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-warm-kl100", "hardcore-warm-kl100-c10")
+    )
+    assert (c10.agent.actor_cvar, kl.agent.actor_cvar) == (0.1, 0.25)
+    c10.agent.actor_cvar = 0.25
+    assert c10 == kl
 
 
 def test_paper_config_is_the_default_but_for_the_learning_rate():
