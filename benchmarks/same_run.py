@@ -1,0 +1,46 @@
+"""Are two runs the same run? Compare their `metrics.csv` row by row (docs/hardcore.md,
+session 10: the seed-1 run retrained on a new machine against its committed metrics).
+
+    python benchmarks/same_run.py docs/runs/hardcore-lrdecay-seed1 runs/hardcore/lrdecay-seed1
+
+Rows are compared on what the run decides (kind, stage, step, episode, return, length, fell and
+the losses), not on wall time. It prints how many leading rows agree, up to the shorter file,
+and the first that differs; the exit status is 1 when one does.
+"""
+
+from __future__ import annotations
+
+import csv
+import sys
+from pathlib import Path
+
+IGNORED = {"wall_time"}
+
+
+def rows(run: Path) -> list[dict[str, str]]:
+    path = run / "metrics.csv" if run.is_dir() else run
+    with path.open(newline="") as f:
+        return [{k: v for k, v in row.items() if k not in IGNORED} for row in csv.DictReader(f)]
+
+
+def main() -> int:
+    if len(sys.argv) != 3:
+        print(__doc__.strip().splitlines()[2].strip(), file=sys.stderr)
+        return 2
+    a, b = (rows(Path(p)) for p in sys.argv[1:])
+    n = min(len(a), len(b))
+    same = next((i for i in range(n) if a[i] != b[i]), n)
+    last = a[same - 1] if same else None
+    where = f" (to step {int(last['step']):,}, episode {last['episode']})" if last else ""
+    print(f"{same:,} of {n:,} rows agree{where}")
+    if same < n:
+        diff = {
+            k: (a[same].get(k), b[same].get(k)) for k in a[same] if a[same][k] != b[same].get(k)
+        }
+        print(f"row {same + 1:,} differs: {diff}")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
