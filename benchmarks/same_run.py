@@ -10,22 +10,30 @@ and the first that differs; the exit status is 1 when one does.
 
 from __future__ import annotations
 
-import csv
 import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from bipedal_cli.metrics import METRICS_FILE, read_metrics  # noqa: E402
 
 IGNORED = {"wall_time"}
 
 
 def rows(run: Path) -> list[dict[str, str]]:
-    path = run / "metrics.csv" if run.is_dir() else run
-    with path.open(newline="") as f:
-        return [{k: v for k, v in row.items() if k not in IGNORED} for row in csv.DictReader(f)]
+    """A run's complete rows (a row being written by a running run is left out), wall time
+    dropped."""
+    path = run / METRICS_FILE if run.is_dir() else run
+    return [{k: v for k, v in row.items() if k not in IGNORED} for row in read_metrics(path)]
 
 
 def main() -> int:
     if len(sys.argv) != 3:
         print(__doc__.strip().splitlines()[2].strip(), file=sys.stderr)
+        return 2
+    missing = [p for p in sys.argv[1:] if not Path(p).exists()]
+    if missing:
+        print(f"no run directory or metrics file at {missing[0]}", file=sys.stderr)
         return 2
     a, b = (rows(Path(p)) for p in sys.argv[1:])
     n = min(len(a), len(b))
