@@ -25,6 +25,7 @@ SHIPPED = {
     "hardcore-h8-fallramp": ("BipedalWalkerHardcore-v3", True, 3, 8, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar-late": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-lrdecay-cvar25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-kl100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
@@ -104,6 +105,29 @@ def test_hardcore_lrdecay_cvar_is_lrdecay_until_its_actor_turns_risk_averse():
     assert (cvar.agent.actor_cvar, cvar.agent.actor_cvar_start) == (0.5, 1_100_000)
     assert actor_lowest_atoms(1_100_001, cvar.agent) == 63  # of 125
     check_branch_config(decay, cvar, 1_100_000, "hardcore-lrdecay-cvar.yaml")
+    cvar.agent.actor_cvar, cvar.agent.actor_cvar_start = None, 0
+    assert cvar == decay
+
+
+def test_hardcore_lrdecay_cvar25_is_seed_1s_decaying_run_until_its_actor_turns_risk_averse():
+    """Session 11's branch: seed 1's run of hardcore-lrdecay.yaml at 1.1M, with the lowest
+    quarter of the atoms from there; nothing else may differ, and the branch check accepts it
+    from that run at 1.1M but not from a step past it."""
+    from bipedal_cli.errors import UserError
+    from bipedal_cli.schedule import actor_lowest_atoms
+    from bipedal_cli.validation import check_branch_config
+
+    decay, cvar = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-lrdecay", "hardcore-lrdecay-cvar25")
+    )
+    decay.seed, decay.train.keep_policies = 1, True  # the seed-1 run's own config
+    assert (cvar.seed, cvar.agent.actor_cvar, cvar.agent.actor_cvar_start) == (1, 0.25, 1_100_000)
+    assert actor_lowest_atoms(1_100_000, cvar.agent) is None  # eq. 2 up to the branch point
+    assert actor_lowest_atoms(1_100_001, cvar.agent) == 31  # then 31 of 125
+    check_branch_config(decay, cvar, 1_100_000, "hardcore-lrdecay-cvar25.yaml")
+    with pytest.raises(UserError, match="actor_cvar_start"):
+        check_branch_config(decay, cvar, 1_100_001, "hardcore-lrdecay-cvar25.yaml")
     cvar.agent.actor_cvar, cvar.agent.actor_cvar_start = None, 0
     assert cvar == decay
 
