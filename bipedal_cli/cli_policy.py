@@ -31,9 +31,8 @@ def eval_(
     workers: Annotated[int, typer.Option("--workers", help="Processes (0: every core).")] = 0,
 ) -> None:
     """Evaluate the deterministic policy tanh(mean) on fixed env seeds (solved: mean > 300)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
-
     from .display import eval_table, verdict
+    from .episode_progress import episode_progress
     from .evaluation import evaluate_actor, summarize
 
     check_count("--episodes", episodes)
@@ -45,18 +44,8 @@ def eval_(
     data, actor, cfg, env_id = _load_policy(ckpt, env)
     seeds = list(range(seed, seed + episodes))
     started = time.perf_counter()
-    with Progress(
-        "[bold]evaluating", BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console
-    ) as progress:
-        task = progress.add_task("eval", total=episodes)
-        results = evaluate_actor(
-            actor,
-            cfg.agent,
-            env_id,
-            seeds,
-            workers=workers,
-            on_episodes=lambda n: progress.advance(task, n),
-        )
+    with episode_progress(console, "evaluating", episodes) as advance:
+        results = evaluate_actor(actor, cfg.agent, env_id, seeds, workers, on_episodes=advance)
     elapsed = time.perf_counter() - started
     summary = summarize(results, cfg.train.solved_threshold)
     summary.update({"env": env_id, "seeds": [seeds[0], seeds[-1]], "checkpoint": str(ckpt)})

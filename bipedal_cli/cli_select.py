@@ -110,26 +110,15 @@ def select(
 def _evaluate(candidates, seeds: list[int], workers: int) -> tuple[list[dict], list[list]]:
     """Each candidate's summary over one episode per seed, and its episodes, under one
     progress bar."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
-
     from .checkpoint import actor_from_checkpoint, load_checkpoint
+    from .episode_progress import episode_progress
     from .evaluation import evaluate_actor, summarize
 
     scores, episodes = [], []
-    with Progress(
-        "[bold]held-out", BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), console=console
-    ) as progress:
-        task = progress.add_task("select", total=len(candidates) * len(seeds))
+    with episode_progress(console, "held-out", len(candidates) * len(seeds)) as advance:
         for c in candidates:
             actor, cfg = actor_from_checkpoint(load_checkpoint(c.path))
-            results = evaluate_actor(
-                actor,
-                cfg.agent,
-                c.env,
-                seeds,
-                workers,
-                on_episodes=lambda n: progress.advance(task, n),
-            )
+            results = evaluate_actor(actor, cfg.agent, c.env, seeds, workers, on_episodes=advance)
             scores.append(summarize(results, cfg.train.solved_threshold))
             episodes.append(results)
     return scores, episodes
