@@ -26,6 +26,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar-late": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-lrdecay-cvar25-g99": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-kl100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
@@ -130,6 +131,18 @@ def test_hardcore_lrdecay_cvar25_is_seed_1s_decaying_run_until_its_actor_turns_r
         check_branch_config(decay, cvar, 1_100_001, "hardcore-lrdecay-cvar25.yaml")
     cvar.agent.actor_cvar, cvar.agent.actor_cvar_start = None, 0
     assert cvar == decay
+
+
+def test_hardcore_lrdecay_cvar25_g99_is_its_seed_0_run_but_for_the_discount():
+    """Session 16's run from scratch: hardcore-lrdecay-cvar25.yaml's seed-0 run (committed
+    metrics to 1,779,687) with gamma 0.99 per policy step; nothing else may differ."""
+    cvar, g99 = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-lrdecay-cvar25", "hardcore-lrdecay-cvar25-g99")
+    )
+    assert (g99.seed, g99.agent.gamma, cvar.agent.gamma) == (0, 0.99, 0.98)
+    g99.seed, g99.agent.gamma = 1, 0.98
+    assert g99 == cvar
 
 
 def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_282():
