@@ -166,6 +166,10 @@ def plot(
     since: Annotated[
         int, typer.Option("--since", help="Draw from this many env steps on (zoom in).")
     ] = 0,
+    until: Annotated[
+        int | None,
+        typer.Option("--until", help="Draw up to this many env steps (runs of unequal length)."),
+    ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
 ) -> None:
     """Learning curves: moving mean with a +-1 std band, evaluations, the 300 line."""
@@ -173,8 +177,13 @@ def plot(
 
     check_count("--window", window)
     check_count("--since", since, limit=10**12, low=0)
+    if until is not None:
+        check_count("--until", until, limit=10**12, low=since + 1)
     check_output_path(out, "--out", PLOT_SUFFIXES, force)
-    plot_runs(runs, out, label, aggregate, title, metric=metric, window=window, since=since)
+    last = math.inf if until is None else until
+    plot_runs(
+        runs, out, label, aggregate, title, metric=metric, window=window, since=since, until=last
+    )
     console.print(f"wrote {out}")
 
 

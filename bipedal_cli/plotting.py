@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -88,6 +89,11 @@ def aggregate(
     return grid, stacked.mean(0), stacked.std(0)
 
 
+def in_window(steps: np.ndarray, since: float, until: float) -> np.ndarray:
+    """Which points a plot draws: env steps in [since, until]."""
+    return (steps >= since) & (steps <= until)
+
+
 def plot_runs(
     run_dirs: list[Path],
     out: Path,
@@ -98,10 +104,12 @@ def plot_runs(
     metric: str = "return",
     window: int = 10,
     since: float = 0.0,
+    until: float = math.inf,
 ) -> Path:
     """Episode return against env steps: moving mean over ``window`` episodes with +-1 std
     band, evaluations as points, the solved line; several runs overlaid, or averaged per label.
-    Only env steps from ``since`` on are drawn (the moving statistics still see earlier ones)."""
+    Only env steps from ``since`` to ``until`` are drawn (the moving statistics still see earlier
+    ones), so that runs of unequal length can be compared at equal steps."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -135,12 +143,12 @@ def plot_runs(
                 moving_stats(members[0].values, window),
                 label,
             )
-        shown = grid >= since
+        shown = in_window(grid, since, until)
         grid, mean, std = grid[shown], mean[shown], std[shown]
         ax.plot(grid, back(mean), color=color, label=name)
         ax.fill_between(grid, back(mean - std), back(mean + std), color=color, alpha=0.2)
         for c in members:
-            evals = c.eval_steps >= since
+            evals = in_window(c.eval_steps, since, until)
             if evals.any():
                 ax.scatter(
                     c.eval_steps[evals],

@@ -83,6 +83,19 @@ def test_plot_zooms_in_and_smooths_over_a_chosen_window(tmp_path, trained, capsy
     assert code == 2 and "--window 0" in err
 
 
+def test_plot_stops_at_until_so_unequal_runs_compare_at_equal_steps(tmp_path, trained, capsys):
+    from bipedal_cli.plotting import in_window
+
+    steps = np.array([0, 10, 59, 60, 61, 300])
+    assert in_window(steps, 10, 60).tolist() == [False, True, True, True, False, False]
+    assert in_window(steps, 0, np.inf).all()
+    out = tmp_path / "cut.svg"
+    code, _, err = run_cli(["plot", trained, "--since", 10, "--until", 60, "--out", out], capsys)
+    assert code == 0, err
+    code, _, err = run_cli(["plot", trained, "--since", 60, "--until", 60, "--out", out], capsys)
+    assert code == 2 and "--until 60" in err and len(err.strip().splitlines()) == 1
+
+
 def test_export_gives_the_checkpoints_actions_with_torch_alone(tmp_path, trained, capsys):
     out = tmp_path / "policy.pt2"
     code, _, err = run_cli(["export", trained / "policy.pt", "--out", out], capsys)
