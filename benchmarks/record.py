@@ -42,6 +42,9 @@ def machine() -> dict:
         "platform": platform.platform(),
         "python": platform.python_version(),
         "torch": torch.__version__,
+        # the widest vector instructions torch's CPU kernels use here (AVX2, AVX512...): two
+        # machines that report the same CPU name can differ here, and in speed with it
+        "cpu_capability": torch.backends.cpu.get_cpu_capability(),
         "cuda": torch.cuda.get_device_name(0) if torch.cuda.is_available() else None,
     }
 

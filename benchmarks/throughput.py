@@ -204,7 +204,10 @@ def main() -> None:
     import torch
 
     print(f"machine: {cpu_name()}, {os.cpu_count()} cores, {platform.platform()}")
-    print(f"python {platform.python_version()}, torch {torch.__version__}, device {args.device}")
+    print(
+        f"python {platform.python_version()}, torch {torch.__version__}"
+        f" ({torch.backends.cpu.get_cpu_capability()} kernels), device {args.device}"
+    )
     rows = []
     for threads in args.threads:
         eval_episodes = args.eval_episodes if threads == args.threads[0] else 0
