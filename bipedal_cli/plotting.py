@@ -161,6 +161,8 @@ def plot_runs(
                     zorder=3,
                 )
             for env_id, start in c.stages[1:]:
+                if not since <= start <= until:
+                    continue  # a switch outside the window would stretch the axis
                 ax.axvline(start, color=color, linestyle=":", linewidth=1)
                 ax.text(
                     start,
