@@ -25,6 +25,7 @@ TRAIN_FORMAT = "bipedal-train-state"
 POLICY_FORMAT = "bipedal-policy"
 STATE_FILE = "state.pt"
 POLICY_FILE = "policy.pt"
+RESTART_FILE = "restart.pt"  # state.pt without the replay buffer, to commit (run_state.py)
 POLICIES_DIR = "policies"  # train.keep_policies: the policy of every periodic evaluation
 BEST_POLICY_FILE = "best_policy.pt"  # the policy at the best periodic evaluation of its env
 

@@ -212,6 +212,6 @@ def export(
 def info(ckpt: Annotated[Path, typer.Argument(metavar="CKPT")]) -> None:
     """What a checkpoint holds: env, steps, episodes, config, evaluations, format version."""
     from .checkpoint import load_checkpoint
-    from .display import checkpoint_table
+    from .info_table import checkpoint_table
 
     console.print(checkpoint_table(load_checkpoint(ckpt), printable(ckpt)))

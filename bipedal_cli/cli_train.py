@@ -97,7 +97,11 @@ def _exit_if_interrupted(result) -> None:
 
 def resume(
     run: Annotated[
-        Path, typer.Argument(metavar="RUN_DIR_OR_CHECKPOINT", help="Run directory or its state.pt.")
+        Path,
+        typer.Argument(
+            metavar="RUN_DIR_OR_CHECKPOINT",
+            help="Run directory, its state.pt, or (with --into) its restart.pt.",
+        ),
     ],
     steps: Annotated[
         int | None, typer.Option("--steps", help="Train until this many policy steps in all.")
@@ -117,7 +121,11 @@ def resume(
     ] = None,
     into: Annotated[
         Path | None,
-        typer.Option("--into", help="Branch: continue in this new run directory under --config."),
+        typer.Option(
+            "--into",
+            help="Branch: continue in this new run directory under --config; or continue a "
+            "restart.pt there (its replay buffer refilled first).",
+        ),
     ] = None,
     config: Annotated[
         Path | None,
@@ -145,8 +153,6 @@ def resume(
         raise UserError(
             "--config and --set: only with --into (a branch); a resume keeps its config"
         )
-    if into is not None and config is None and not set_:
-        raise UserError("--into: a branch needs --config FILE or --set key=value to change")
     if device:
         resolve_device(device)
     display = TrainingDisplay(console, "resume")

@@ -174,6 +174,10 @@ class TrainConfig:
     init_policy_sha256: str | None = None
     """The sha256 of ``init_policy``'s bytes, checked when the run starts, so that a config
     names one file's content, not whatever lies at that path. null: not checked."""
+    refill_steps: int = 50_000
+    """A run continued from a ``restart.pt`` (no replay buffer: ``bipedal resume FILE --into
+    DIR``) first acts this many policy steps with its own actor, without updates, to refill the
+    buffer it lost; then learning goes on. Changes nothing in a run that is not restarted."""
 
 
 @dataclass

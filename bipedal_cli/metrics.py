@@ -94,6 +94,11 @@ def read_metrics(path: str | Path) -> list[dict[str, str]]:
         return [r for r in csv.DictReader(f) if _complete(r)]
 
 
+def parse_metrics(text: str) -> list[dict[str, str]]:
+    """:func:`read_metrics` of a metrics file's text (the copy a ``restart.pt`` holds)."""
+    return [r for r in csv.DictReader(io.StringIO(text, newline="")) if _complete(r)]
+
+
 def _complete(row: dict) -> bool:
     if None in row or any(v is None for v in row.values()):  # too many or too few fields
         return False

@@ -9,6 +9,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+from .branch_rules import check_branch_config
 from .checkpoint import (
     BEST_POLICY_FILE,
     STATE_FILE,
@@ -21,12 +22,11 @@ from .checkpoint import (
 from .config import Config, config_from_dict, override_config
 from .curriculum import continue_curriculum
 from .errors import UserError
-from .metrics import METRICS_FILE, MetricsWriter, read_metrics
-from .paths import atomic_path
+from .metrics import METRICS_FILE, MetricsWriter, parse_metrics, read_metrics
+from .paths import atomic_path, printable
 from .reporting import Reporter
 from .rundir import BRANCH_FILE, lock_run_dir, prepare_new_run_dir
 from .train import Trainer
-from .validation import check_branch_config
 
 
 def state_path_of(path: str | Path) -> Path:
@@ -42,14 +42,20 @@ def state_path_of(path: str | Path) -> Path:
     return path / STATE_FILE
 
 
-def load_training_state(path: str | Path) -> tuple[Path, dict]:
-    """``state.pt`` of ``path`` (a run directory or the file), refused when policy-only."""
+def load_training_state(path: str | Path, restart_ok: bool = False) -> tuple[Path, dict]:
+    """``state.pt`` of ``path`` (a run directory or the file), refused when policy-only, and
+    a ``restart.pt`` (no replay buffer) unless ``restart_ok``: it continues in a new directory."""
     state_path = state_path_of(path)
     state = load_checkpoint(state_path, "RUN_DIR_OR_CHECKPOINT")
     if state["format"] != TRAIN_FORMAT:
         raise UserError(
             f"RUN_DIR_OR_CHECKPOINT {state_path}: a policy-only checkpoint cannot be resumed; "
             f"expected the run's {STATE_FILE}"
+        )
+    if state.get("restart") is not None and not restart_ok:
+        raise UserError(
+            f"RUN_DIR_OR_CHECKPOINT {state_path}: a restart file (no replay buffer) continues "
+            f"in a new run directory: bipedal resume {printable(state_path)} --into DIR"
         )
     return state_path, state
 
@@ -133,14 +139,22 @@ def branch(
 
     ``cfg`` may differ from the run's config only by features that start at or after the run's
     step (a learning-rate decay, replay curation) and by device, threads, budget and kept
-    policies (:func:`~bipedal_cli.validation.check_branch_config`): the branch is then, to the
+    policies (:func:`~bipedal_cli.branch_rules.check_branch_config`): the branch is then, to the
     bit, the run that ``cfg`` trains from scratch, so two recipes can be compared from one
     shared start. The source is only read; ``into`` gets the source's metrics up to the branch
-    step and its best policy."""
-    state_path, state = load_training_state(path)
+    step and its best policy.
+
+    ``path`` may also be a ``restart.pt`` (:func:`~bipedal_cli.run_state.restart_state`), and
+    ``cfg`` and ``overrides`` may then be left out: the run goes on from the file's step in
+    ``into`` with the metrics the file holds, and first refills its replay buffer, acting for
+    ``train.refill_steps`` policy steps without updates."""
+    state_path, state = load_training_state(path, restart_ok=True)
+    restart = state.get("restart")
     step = int(state["counters"]["step"])
     if state.get("curriculum") is not None:
         raise UserError(f"RUN_DIR_OR_CHECKPOINT {state_path}: a curriculum run cannot be branched")
+    if restart is None and cfg is None and not overrides:
+        raise UserError("--into: a branch needs --config FILE or --set key=value to change")
     run_cfg = config_from_dict(state["config"], f"{state_path}: config")
     if cfg is None:
         config_source = f"{state_path}: config + --set"
@@ -150,13 +164,23 @@ def branch(
     with lock_run_dir(into):
         trainer = Trainer(cfg, into, reporter)
         trainer.load_state_dict(state)
-        source_metrics = state_path.parent / METRICS_FILE
-        if source_metrics.exists():
-            rows = [r for r in read_metrics(source_metrics) if int(float(r["step"])) <= step]
+        if restart is not None:
+            trainer.refill_until = step + cfg.train.refill_steps
+            rows = parse_metrics(restart["metrics_csv"])
+            origin = f"restart file {state_path.resolve()} at step {step}"
+        else:
+            source_metrics = state_path.parent / METRICS_FILE
+            rows = read_metrics(source_metrics) if source_metrics.exists() else None
+            _copy_best_policy(state_path.parent / BEST_POLICY_FILE, into, cfg.env, step)
+            origin = f"{state_path.resolve()} at step {step}"
+        if rows is not None:
+            rows = [r for r in rows if int(float(r["step"])) <= step]
             MetricsWriter(into / METRICS_FILE).replace_rows(rows)
-        best = state_path.parent / BEST_POLICY_FILE
-        if recorded_evaluation(best, cfg.env) is not None and policy_step(best) <= step:
-            with atomic_path(into / BEST_POLICY_FILE) as tmp:
-                shutil.copyfile(best, tmp)
-        atomic_write_text(into / BRANCH_FILE, f"{state_path.resolve()} at step {step}\n")
+        atomic_write_text(into / BRANCH_FILE, f"{origin}\n")
         return trainer.run(until_solved=until_solved)
+
+
+def _copy_best_policy(best: Path, into: Path, env_id: str, step: int) -> None:
+    if recorded_evaluation(best, env_id) is not None and policy_step(best) <= step:
+        with atomic_path(into / BEST_POLICY_FILE) as tmp:
+            shutil.copyfile(best, tmp)

@@ -1,8 +1,9 @@
 """Run directories: naming a new one, refusing one that already holds a run, writing its config.
 
-A run directory holds ``config.yaml``, ``metrics.csv``, ``state.pt``, ``policy.pt`` and
-``learning_curve.png``. Every file in it is written as a new file renamed over the old one
-(:func:`bipedal_cli.paths.atomic_path`), never through an existing file or link.
+A run directory holds ``config.yaml``, ``metrics.csv``, ``state.pt``, ``restart.pt`` (the
+state without its replay buffer), ``policy.pt`` and ``learning_curve.png``. Every file in it is
+written as a new file renamed over the old one (:func:`bipedal_cli.paths.atomic_path`), never
+through an existing file or link.
 """
 
 from __future__ import annotations

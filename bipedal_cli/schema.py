@@ -105,6 +105,10 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
     wall = _get(counters, "wall_time", (int, float), where, "counters.")
     if not math.isfinite(wall):
         raise _fail(where, "counters.wall_time", "should be finite")
+    if "refill_until" in counters and _get(counters, "refill_until", int, where, "counters.") < 0:
+        raise _fail(where, "counters.refill_until", "should not be negative")
+    if data.get("restart") is not None:
+        _check_restart(data, where)
     episode = _get(data, "episode", Mapping, where)
     actions = _get(episode, "actions", torch.Tensor, where, "episode.")
     if actions.dim() != 2 or actions.shape[1] != act_dim:
@@ -122,6 +126,16 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
     if "recent_falls" in data:  # since 2026-11-24; older checkpoints start it empty
         _get(data, "recent_falls", list, where)
     return cfg
+
+
+def _check_restart(data: dict, where: str) -> None:
+    """A ``restart.pt``: the step it was written at, the run's metrics, and no replay."""
+    restart = _get(data, "restart", Mapping, where)
+    if _get(restart, "step", int, where, "restart.") != data["counters"]["step"]:
+        raise _fail(where, "restart.step", "should be counters.step")
+    _get(restart, "metrics_csv", str, where, "restart.")
+    if data["buffer"]["size"] != 0:
+        raise _fail(where, "buffer", "should be empty in a restart file")
 
 
 def _check_optimizer(state: Mapping, shapes: dict | None, where: str, key: str) -> None:

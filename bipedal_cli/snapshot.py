@@ -34,6 +34,8 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         "phase": (
             "warm-up"
             if trainer.step < t.warmup_steps
+            else "refilling replay"  # restarted from a restart.pt: acting, no updates yet
+            if trainer.step < trainer.refill_until
             else "critics only"  # agent.actor_update_start: the actor and alpha wait
             if actor_frozen(trainer.step, trainer.cfg.agent)
             else "training"

@@ -1,7 +1,9 @@
 """The training loop: warm-up, one (or more) TQC updates per policy step, evaluation, checkpoints.
 
 A run lives in one directory (:mod:`bipedal_cli.rundir`): ``config.yaml``, ``metrics.csv``,
-``state.pt`` (everything an exact resume needs) and ``policy.pt`` (the actor alone).
+``state.pt`` (everything an exact resume needs), ``restart.pt`` (the same without the replay
+buffer: small enough to commit, so that a run outlives its directory) and ``policy.pt`` (the
+actor alone).
 
 Exact resume (:mod:`bipedal_cli.run_state`): every source of randomness is checkpointed, and an
 episode cut by a checkpoint is rebuilt by replaying it. Periodic evaluations, best and kept
@@ -28,16 +30,15 @@ import torch
 from .agent import TQCAgent
 from .anchor import anchored
 from .buffer import ReplayBuffer
-from .checkpoint import POLICY_FILE, STATE_FILE, atomic_save, initial_actor_state
+from .checkpoint import STATE_FILE, atomic_save, initial_actor_state
 from .config import Config
 from .devices import configure_threads, resolve_device
 from .envs import policy_dims
 from .episodes import EpisodeRunner, FinishedEpisode, curation_on
-from .errors import UserError
 from .metrics import METRICS_FILE, MetricsWriter
 from .periodic_eval import evaluate_on_eval_seeds, periodic_evaluation
 from .reporting import NullReporter, Reporter
-from .run_state import policy_file, restore_run_state, run_state
+from .run_state import diverged, policy_file, restore_run_state, run_state, save_run
 from .rundir import (
     default_run_dir,
     lock_run_dir,
@@ -86,6 +87,7 @@ class Trainer:
         self.rng = np.random.default_rng(cfg.seed)
         self.step = 0  # policy steps
         self.env_steps = 0
+        self.refill_until = 0  # a restart from a restart.pt: no updates up to this policy step
         self.episodes = 0
         self.wall_time = 0.0
         self.recent_returns: deque[float] = deque(maxlen=100)
@@ -107,22 +109,9 @@ class Trainer:
     def load_state_dict(self, state: dict[str, Any]) -> None:
         restore_run_state(self, state)
 
-    def _diverged(self, what: str) -> UserError:
-        saved = self.run_dir / STATE_FILE
-        return UserError(
-            f"training diverged at step {self.step:,}: {what} is not finite (NaN or inf); "
-            f"{saved} keeps the last good checkpoint"
-        )
-
     def save(self) -> None:
-        """state.pt and policy.pt; refused (the last good ones kept) when a network holds NaN."""
-        self.agent.sync()
-        for name in ("actor", "critic"):
-            params = getattr(self.agent, name).parameters()
-            if not all(bool(torch.isfinite(p).all()) for p in params):
-                raise self._diverged(f"the {name}'s weights")
-        atomic_save(self.state_dict(), self.run_dir / STATE_FILE)
-        self.save_policy(self.run_dir / POLICY_FILE)
+        """state.pt, restart.pt and policy.pt (:func:`~bipedal_cli.run_state.save_run`)."""
+        save_run(self)
 
     def save_policy(self, path: Path) -> None:
         atomic_save(policy_file(self), path)
@@ -186,7 +175,7 @@ class Trainer:
                     stopped = "interrupted"
                     break
                 self._env_step(metrics, wall_base, session_start)
-                if self.step > t.warmup_steps and len(self.buffer) >= cfg.agent.batch_size:
+                if self.learning():
                     lr = scheduled_learning_rate(self.step, cfg.agent)
                     if lr is not None:
                         self.agent.set_learning_rate(lr)
@@ -215,6 +204,11 @@ class Trainer:
             self.wall_time = wall_base + time.perf_counter() - session_start
         return stopped, steps_per_s
 
+    def learning(self) -> bool:
+        """Updates run after the warm-up, and after a restart's refill (``refill_until``)."""
+        after = max(self.cfg.train.warmup_steps, self.refill_until)
+        return self.step > after and len(self.buffer) >= self.cfg.agent.batch_size
+
     def write_plot(self) -> Path | None:
         """``learning_curve.png`` in the run directory (skipped before the first episode ends)."""
         return write_plot(self.run_dir) if self.episodes else None
@@ -231,7 +225,7 @@ class Trainer:
         else:
             action = self.agent.act(self.runner.obs)
             if not np.isfinite(action).all():  # Box2D must never see a NaN action
-                raise self._diverged("the policy's action")
+                raise diverged(self, "the policy's action")
         env_steps_before = self.runner.episode.env_steps
         finished = self.runner.step(action)
         self.step += 1

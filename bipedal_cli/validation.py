@@ -132,6 +132,7 @@ def validate(cfg: Any, source: str) -> None:
         (t.reward_scale > 0, "train.reward_scale", "a positive number"),
         (t.total_steps >= 0, "train.total_steps", "a non-negative integer"),
         (t.warmup_steps >= 0, "train.warmup_steps", "a non-negative integer"),
+        (t.refill_steps >= 0, "train.refill_steps", "a non-negative integer"),
         (t.buffer_size >= 1, "train.buffer_size", "a positive integer"),
         (t.updates_per_step >= 0, "train.updates_per_step", "a non-negative integer"),
         (t.eval_every >= 0, "train.eval_every", "a non-negative integer"),
@@ -172,84 +173,4 @@ def validate(cfg: Any, source: str) -> None:
             f"{source}: key 'train.buffer_size' expects a buffer that fits in memory: "
             f"{t.buffer_size:,} transitions need {need / 2**30:.1f} GiB, this machine has "
             f"{have / 2**30:.1f} GiB"
-        )
-
-
-BRANCH_MAY_CHANGE = ("device", "train.threads", "train.total_steps", "train.keep_policies")
-# Features that start at a policy step: (their keys, the key of that step, is-on, its step).
-DEFERRED = (
-    (
-        ("agent.lr_final", "agent.lr_decay_start", "agent.lr_decay_end"),
-        "agent.lr_decay_start",
-        lambda c: c.agent.lr_final is not None,
-        lambda c: c.agent.lr_decay_start,
-    ),
-    (
-        ("train.replay_keep_below", "train.replay_curation_start"),
-        "train.replay_curation_start",
-        lambda c: c.train.replay_keep_below is not None,
-        lambda c: c.train.replay_curation_start,
-    ),
-    (
-        (
-            "train.fall_penalty_final",
-            "train.fall_penalty_ramp_start",
-            "train.fall_penalty_ramp_end",
-        ),
-        "train.fall_penalty_ramp_start",
-        lambda c: c.train.fall_penalty_final is not None,
-        lambda c: c.train.fall_penalty_ramp_start,
-    ),
-    (
-        ("agent.actor_cvar", "agent.actor_cvar_start"),
-        "agent.actor_cvar_start",
-        lambda c: c.agent.actor_cvar is not None,
-        lambda c: c.agent.actor_cvar_start,
-    ),
-    # the anchor pulls nothing while the actor waits: it is still the anchor itself
-    (
-        ("agent.actor_anchor", "agent.actor_anchor_kl"),
-        "agent.actor_update_start",
-        lambda c: c.agent.actor_anchor is not None or c.agent.actor_anchor_kl is not None,
-        lambda c: c.agent.actor_update_start,
-    ),
-)
-
-
-def _flat(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for key, value in data.items():
-        if isinstance(value, dict):
-            out.update(_flat(value, f"{prefix}{key}."))
-        else:
-            out[f"{prefix}{key}"] = value
-    return out
-
-
-def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> None:
-    """A branch of a run at ``step`` (``bipedal resume RUN --into DIR --config NEW``) must be the
-    run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
-    threads, budget and kept policies (they do not change the bits), and features that start
-    at a policy step (DEFERRED: learning-rate decay, replay curation, fall-penalty ramp,
-    risk-averse actor) as long as they change nothing before ``step``. One line naming the
-    first key that breaks this."""
-    old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
-    deferred_keys: set[str] = set()
-    for keys, start_key, is_on, start in DEFERRED:
-        deferred_keys.update(keys)
-        if all(old[k] == new[k] for k in keys):
-            continue
-        if any(is_on(c) and start(c) < step for c in (run_cfg, new_cfg)):
-            raise UserError(
-                f"{source}: key {start_key!r} expects a step at or after the branch point "
-                f"{step:,} (the run up to there must stay as it was)"
-            )
-    for key, value in new.items():
-        if key in BRANCH_MAY_CHANGE or key in deferred_keys or old.get(key) == value:
-            continue
-        raise UserError(
-            f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
-            "change only device, train.threads, train.total_steps, train.keep_policies and "
-            "features that start at or after the branch point (learning-rate decay, replay "
-            "curation, fall-penalty ramp, risk-averse actor, actor anchor)"
         )

@@ -52,7 +52,7 @@ def test_every_shipped_config_is_tested():
 
 def test_hardcore_lrdecay_is_hardcore_until_its_decay_starts():
     """It was trained as a branch of hardcore.yaml's run at step 1,092,168 (docs/hardcore.md)."""
-    from bipedal_cli.validation import check_branch_config
+    from bipedal_cli.branch_rules import check_branch_config
 
     base, decay = (resolve_config(CONFIGS / f"{n}.yaml") for n in ("hardcore", "hardcore-lrdecay"))
     assert base.agent.lr_final is None
@@ -97,8 +97,8 @@ def test_hardcore_h8_fallramp_is_h8_curated_until_its_ramp_starts():
 def test_hardcore_lrdecay_cvar_is_lrdecay_until_its_actor_turns_risk_averse():
     """It branches from hardcore-lrdecay.yaml's runs at 1.1M: nothing but the actor's objective
     may differ, and the branch check accepts it from a run at that step."""
+    from bipedal_cli.branch_rules import check_branch_config
     from bipedal_cli.schedule import actor_lowest_atoms
-    from bipedal_cli.validation import check_branch_config
 
     decay, cvar = (
         resolve_config(CONFIGS / f"{n}.yaml") for n in ("hardcore-lrdecay", "hardcore-lrdecay-cvar")
@@ -114,9 +114,9 @@ def test_hardcore_lrdecay_cvar25_is_seed_1s_decaying_run_until_its_actor_turns_r
     """Session 11's branch: seed 1's run of hardcore-lrdecay.yaml at 1.1M, with the lowest
     quarter of the atoms from there; nothing else may differ, and the branch check accepts it
     from that run at 1.1M but not from a step past it."""
+    from bipedal_cli.branch_rules import check_branch_config
     from bipedal_cli.errors import UserError
     from bipedal_cli.schedule import actor_lowest_atoms
-    from bipedal_cli.validation import check_branch_config
 
     decay, cvar = (
         resolve_config(CONFIGS / f"{n}.yaml")
@@ -147,7 +147,7 @@ def test_hardcore_lrdecay_cvar25_g99_is_its_seed_0_run_but_for_the_discount():
 
 def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_282():
     """The pilot: seed 0's decaying run, branched where it stood when the key was added."""
-    from bipedal_cli.validation import check_branch_config
+    from bipedal_cli.branch_rules import check_branch_config
 
     decay, late = (
         resolve_config(CONFIGS / f"{n}.yaml")
@@ -204,7 +204,7 @@ def test_hardcore_warm_configs_are_lrdecay_from_the_committed_parent(name, ancho
 def test_hardcore_warm_kl_configs_are_branches_of_the_anchor25_run_at_its_actor_start(beta):
     """Made as branches of hardcore-warm-anchor25.yaml's run at 60,000, where the actor starts:
     the branch check accepts them there, and nothing but the anchor differs."""
-    from bipedal_cli.validation import check_branch_config
+    from bipedal_cli.branch_rules import check_branch_config
 
     a25 = resolve_config(CONFIGS / "hardcore-warm-anchor25.yaml")
     kl = resolve_config(CONFIGS / f"hardcore-warm-kl{beta:.0f}.yaml")
@@ -220,7 +220,7 @@ def test_hardcore_warm_kl_configs_are_branches_of_the_anchor25_run_at_its_actor_
 def test_hardcore_warm_kl100_fall_configs_are_branches_of_the_kl100_run(final):
     """Made as branches of hardcore-warm-kl100.yaml's run at 325,163 (session 10): the branch
     check accepts them there, not after the ramp has started, and nothing but the ramp differs."""
-    from bipedal_cli.validation import check_branch_config
+    from bipedal_cli.branch_rules import check_branch_config
 
     kl = resolve_config(CONFIGS / "hardcore-warm-kl100.yaml")
     ramp = resolve_config(CONFIGS / f"hardcore-warm-kl100-fall{final:.0f}.yaml")
