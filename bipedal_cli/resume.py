@@ -60,6 +60,15 @@ def load_training_state(path: str | Path, restart_ok: bool = False) -> tuple[Pat
     return state_path, state
 
 
+def check_budget(total_steps: int, step: int, option: str) -> None:
+    """A resumed or branched run's budget is its new total of policy steps: at least its step."""
+    if total_steps < step:
+        raise UserError(
+            f"{option} {total_steps}: the run is at step {step:,}; expected the new total, at "
+            "least that"
+        )
+
+
 def load_trainer(
     path: str | Path,
     reporter: Reporter | None = None,
@@ -76,11 +85,8 @@ def load_trainer(
     """
     state_path, state = load_training_state(path)
     step = int(state["counters"]["step"])
-    if total_steps is not None and total_steps < step:
-        raise UserError(
-            f"--steps {total_steps}: the run is at step {step:,}; expected the new total, at "
-            "least that"
-        )
+    if total_steps is not None:
+        check_budget(total_steps, step, "--steps")
     data = dict(state["config"])
     if device:
         data["device"] = device
@@ -160,6 +166,7 @@ def branch(
         config_source = f"{state_path}: config + --set"
         cfg = override_config(state["config"], config_source, overrides, **(explicit or {}))
     check_branch_config(run_cfg, cfg, step, config_source)
+    check_budget(cfg.train.total_steps, step, "--steps (train.total_steps)")
     into = prepare_new_run_dir(into, "--into")
     with lock_run_dir(into):
         trainer = Trainer(cfg, into, reporter)

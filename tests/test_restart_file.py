@@ -148,3 +148,17 @@ def test_cli_continues_a_restart_file_and_info_names_it(tmp_path, stopped_run, c
     state = load_checkpoint(into / "state.pt")
     assert state["counters"]["step"] == 300 and state["counters"]["refill_until"] == 270
     assert state["config"]["train"]["refill_steps"] == 40
+
+
+@pytest.mark.parametrize("source", ["restart.pt", "state.pt"])
+def test_a_budget_below_the_runs_step_is_refused_before_the_directory_is_made(
+    tmp_path, stopped_run, source
+):
+    explicit = {"train.total_steps": 100}
+    overrides = None if source == "restart.pt" else ["train.keep_policies=true"]
+    refused = r"--steps \(train.total_steps\) 100: the run is at step 230"
+    with pytest.raises(UserError, match=refused):
+        branch(stopped_run / source, tmp_path / "x", overrides=overrides, explicit=explicit)
+    assert not (tmp_path / "x").exists()
+    with pytest.raises(UserError, match="--steps 100: the run is at step 230"):
+        resume(stopped_run, total_steps=100)
