@@ -1,0 +1,58 @@
+"""The restart files committed under ``checkpoints/restarts/`` (a long run's state without its
+replay buffer, so that the run outlives a move to another machine) are what docs/hardcore.md says
+they are: restart files of the named config and seed, whose metrics are the committed copy's."""
+
+import csv
+import io
+from pathlib import Path
+
+import pytest
+
+from bipedal_cli.branch_rules import BRANCH_MAY_CHANGE
+from bipedal_cli.checkpoint import load_checkpoint
+from bipedal_cli.config import config_from_dict, resolve_config
+from bipedal_cli.metrics import parse_metrics, read_metrics
+
+ROOT = Path(__file__).resolve().parent.parent
+RESTARTS = ROOT / "checkpoints" / "restarts"
+# restart file: (the config that trained it, its seed, the committed copy of its metrics)
+COMMITTED = {
+    "hardcore-lrdecay-cvar25-g99-seed0-rerun.pt": (
+        "hardcore-lrdecay-cvar25-g99.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-g99-seed0-rerun/metrics.csv",
+    ),
+}
+
+
+def test_every_committed_restart_file_is_listed_here():
+    assert sorted(p.name for p in RESTARTS.glob("*.pt")) == sorted(COMMITTED)
+
+
+@pytest.mark.parametrize("name", sorted(COMMITTED))
+def test_committed_restart_file_is_its_configs_run_with_the_committed_metrics(name):
+    config, seed, metrics = COMMITTED[name]
+    data = load_checkpoint(RESTARTS / name)  # checkpoint.py checks every field
+    assert data["restart"] is not None and data["buffer"]["size"] == 0
+    step = data["counters"]["step"]
+    run_cfg = config_from_dict(data["config"])
+    committed_cfg = resolve_config(ROOT / "configs" / config, seed=seed)
+    # the file's config is the committed one but for what changes no bit (threads, budget)
+    assert flat(run_cfg.to_dict()) == flat(committed_cfg.to_dict())
+    rows = parse_metrics(data["restart"]["metrics_csv"])
+    assert rows and int(float(rows[-1]["step"])) <= step
+    copy = read_metrics(ROOT / metrics)
+    assert copy[: len(rows)] == rows, f"{metrics} is not the restart file's metrics"
+    header = next(csv.reader(io.StringIO(data["restart"]["metrics_csv"])))
+    assert header == list(copy[0])
+
+
+def flat(data: dict, prefix: str = "") -> dict:
+    """A config dict as dotted keys, without those a branch may change (device, threads...)."""
+    out = {}
+    for key, value in data.items():
+        if isinstance(value, dict):
+            out.update(flat(value, f"{prefix}{key}."))
+        elif f"{prefix}{key}" not in BRANCH_MAY_CHANGE:
+            out[f"{prefix}{key}"] = value
+    return out
