@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from bipedal_cli.branch_rules import BRANCH_MAY_CHANGE
+from bipedal_cli.branch_rules import BRANCH_MAY_CHANGE, _flat
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict, resolve_config
 from bipedal_cli.metrics import parse_metrics, read_metrics
@@ -47,12 +47,6 @@ def test_committed_restart_file_is_its_configs_run_with_the_committed_metrics(na
     assert header == list(copy[0])
 
 
-def flat(data: dict, prefix: str = "") -> dict:
+def flat(data: dict) -> dict:
     """A config dict as dotted keys, without those a branch may change (device, threads...)."""
-    out = {}
-    for key, value in data.items():
-        if isinstance(value, dict):
-            out.update(flat(value, f"{prefix}{key}."))
-        elif f"{prefix}{key}" not in BRANCH_MAY_CHANGE:
-            out[f"{prefix}{key}"] = value
-    return out
+    return {k: v for k, v in _flat(data).items() if k not in BRANCH_MAY_CHANGE}
