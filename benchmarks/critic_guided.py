@@ -12,7 +12,8 @@ K = 1 is the plain deterministic policy. The actor and critics come from one tra
 1,944,373 it did not cut the falls (docs/hardcore.md, session 20).
 
     python benchmarks/critic_guided.py \\
-        checkpoints/restarts/hardcore-lrdecay-cvar25-g99-seed0-rerun.pt --candidates 64 --seed 23000000 --episodes 200
+        checkpoints/restarts/hardcore-lrdecay-cvar25-g99-seed0-rerun.pt --candidates 64 \\
+        --seed 23000000 --episodes 200
 
 One process, one thread; the draws are seeded, so a run is reproducible.
 """
