@@ -12,17 +12,20 @@ K = 1 is the plain deterministic policy. The actor and critics come from one tra
 1,944,373 it did not cut the falls (docs/hardcore.md, session 20).
 
     python benchmarks/critic_guided.py \\
-        checkpoints/restarts/hardcore-lrdecay-cvar25-g99-seed0-rerun.pt --candidates 64 \\
-        --seed 23000000 --episodes 200
+        checkpoints/restarts/hardcore-lrdecay-cvar25-g99-seed0-rerun.pt --candidates 1 64 \\
+        --seed 23000000 --episodes 600
 
-One process, one thread; the draws are seeded, so a run is reproducible.
+Every K plays the same seeds, and the script prints each K's paired difference from the first.
+The draws of each batch of 10 seeds are seeded by its first seed, so a seed's result does not
+depend on the block it is played in or on the number of workers (one thread each).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
-import math
+import multiprocessing as mp
 import sys
 from pathlib import Path
 
@@ -30,68 +33,92 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bipedal_cli.checkpoint import actor_from_checkpoint, load_checkpoint  # noqa: E402
+from bipedal_cli.agent import TQCAgent  # noqa: E402
+from bipedal_cli.checkpoint import load_checkpoint  # noqa: E402
 from bipedal_cli.config import config_from_dict  # noqa: E402
-from bipedal_cli.evaluation import run_episodes, summarize  # noqa: E402
-from bipedal_cli.networks import QuantileCritics  # noqa: E402
+from bipedal_cli.evaluation import paired_difference, run_episodes, summarize  # noqa: E402
+from bipedal_cli.schedule import actor_lowest_atoms  # noqa: E402
 
 
-def lowest_atoms_mean(atoms: torch.Tensor, fraction: float) -> torch.Tensor:
-    """atoms: (B, N, M) -> (1 / L) sum_{i <= L} z_(i), L = max(1, floor(c N M + 1/2)): (B,)."""
+def lowest_atoms_mean(atoms: torch.Tensor, lowest: int) -> torch.Tensor:
+    """atoms: (B, N, M) -> (1 / L) sum_{i <= L} z_(i) with L = ``lowest``: (B,)."""
     pooled = atoms.flatten(1).sort(dim=1).values  # (B, N M)
-    lowest = max(1, math.floor(fraction * pooled.shape[1] + 0.5))
     return pooled[:, :lowest].mean(1)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("state", type=Path, help="restart.pt or state.pt of a run")
-    parser.add_argument("--candidates", type=int, default=16)
-    parser.add_argument("--fraction", type=float, default=0.25, help="c: the lowest atoms' share")
-    parser.add_argument("--seed", type=int, default=23_000_000)
-    parser.add_argument("--episodes", type=int, default=200)
-    parser.add_argument("--json", type=Path, default=None)
-    args = parser.parse_args()
+BATCH = 10  # episodes in lockstep; the draws of a batch are seeded by its first env seed
+
+
+def load_agent(path: Path, fraction: float):
+    """The actor, the critics and the lowest-atom count L of a training state."""
+    data = load_checkpoint(path)
+    cfg = config_from_dict(data["config"], f"STATE {path}: config")
+    agent = TQCAgent(cfg.agent, int(data["obs_dim"]), int(data["act_dim"]))
+    agent.load_state_dict(data["agent"])
+    # the actor's own count of lowest atoms for a CVaR fraction c (schedule.py)
+    risk = dataclasses.replace(cfg.agent, actor_cvar=fraction, actor_cvar_start=0)
+    return agent.actor.eval(), agent.critic.eval(), actor_lowest_atoms(1, risk), cfg
+
+
+def play_batch(job: tuple[Path, float, int, list[int]]):
+    """One batch of seeds with K candidates per step: a list of EpisodeResult."""
+    path, fraction, k, seeds = job
     torch.set_num_threads(1)
-    data = load_checkpoint(args.state)
-    actor, cfg = actor_from_checkpoint(data)
-    a = config_from_dict(data["config"]).agent
-    critic = QuantileCritics(
-        int(data["obs_dim"]), int(data["act_dim"]), a.critic_hidden, a.n_layers,
-        a.n_critics, a.n_quantiles, a.d2rl,
-    )  # fmt: skip
-    critic.load_state_dict(data["agent"]["critic"])
-    critic.eval()
-    noise = torch.Generator().manual_seed(args.seed)
-    k = args.candidates
+    actor, critic, lowest, cfg = load_agent(path, fraction)
+    noise = torch.Generator().manual_seed(seeds[0])
 
     @torch.no_grad()
     def policy(obs):  # (B, obs_dim) -> (B, act_dim)
         x = torch.as_tensor(obs)
         mean, log_std = actor.distribution_params(x)  # (B, A) each
+        if k == 1:
+            return torch.tanh(mean).numpy()
         eps = torch.randn((k - 1, *mean.shape), generator=noise)  # (K-1, B, A)
         draws = torch.tanh(mean + log_std.exp() * eps)  # (K-1, B, A)
         cands = torch.cat([torch.tanh(mean)[None], draws])  # (K, B, A)
-        if k == 1:
-            return cands[0].numpy()
         b = x.shape[0]
         atoms = critic(x.repeat(k, 1), cands.reshape(k * b, -1))  # (K B, N, M)
-        score = lowest_atoms_mean(atoms, args.fraction).reshape(k, b)  # (K, B)
+        score = lowest_atoms_mean(atoms, lowest).reshape(k, b)  # (K, B)
         return cands[score.argmax(0), torch.arange(b)].numpy()  # (B, A)
 
+    return run_episodes(policy, cfg.env, seeds, cfg.agent)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("state", type=Path, help="restart.pt or state.pt of a run")
+    parser.add_argument("--candidates", type=int, nargs="+", default=[1, 64], help="K, each")
+    parser.add_argument("--fraction", type=float, default=0.25, help="c: the lowest atoms' share")
+    parser.add_argument("--seed", type=int, default=23_000_000)
+    parser.add_argument("--episodes", type=int, default=200)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--json", type=Path, default=None)
+    args = parser.parse_args()
+    _, _, _, cfg = load_agent(args.state, args.fraction)
     seeds = list(range(args.seed, args.seed + args.episodes))
-    results = []
-    for i in range(0, len(seeds), 10):
-        results += run_episodes(policy, cfg.env, seeds[i : i + 10], cfg.agent)
-    s = summarize(results, cfg.train.solved_threshold)
-    print(f"{args.state}, {k} candidates, c {args.fraction}: env seeds {seeds[0]}..{seeds[-1]}")
-    print(
-        f"  {s['mean']:.1f} +- {s['std']:.1f}, median {s['median']:.1f}, falls {s['falls']} "
-        f"{s['falls_at']}, mean length {s['mean_length']:.0f}"
-    )
+    batches = [seeds[i : i + BATCH] for i in range(0, len(seeds), BATCH)]
+    jobs = [(args.state, args.fraction, k, b) for k in args.candidates for b in batches]
+    with mp.get_context("fork").Pool(args.workers) as pool:
+        played = pool.map(play_batch, jobs, chunksize=1)
+    by_k = {k: sum(played[i * len(batches) : (i + 1) * len(batches)], []) for i, k in
+            enumerate(args.candidates)}  # fmt: skip
+    print(f"{args.state}, c {args.fraction}: env seeds {seeds[0]}..{seeds[-1]}")
+    out = {"seeds": seeds, "fraction": args.fraction, "candidates": {}}
+    for k, results in by_k.items():
+        s = summarize(results, cfg.train.solved_threshold)
+        print(
+            f"  K = {k}: {s['mean']:.1f} +- {s['std']:.1f}, median {s['median']:.1f}, falls "
+            f"{s['falls']} {s['falls_at']}, mean length {s['mean_length']:.0f}"
+        )
+        out["candidates"][k] = {"summary": s, "returns": [r.ret for r in results]}
+    first = args.candidates[0]
+    for k in args.candidates[1:]:
+        d = paired_difference(by_k[k], by_k[first])
+        print(
+            f"  K = {k} minus K = {first}: {d['mean']:+.1f} ({d['low']:+.1f} to {d['high']:+.1f})"
+        )
     if args.json:
-        returns = [r.ret for r in results]
-        args.json.write_text(json.dumps({"summary": s, "seeds": seeds, "returns": returns}))
+        args.json.write_text(json.dumps(out))
 
 
 if __name__ == "__main__":
