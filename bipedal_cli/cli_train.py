@@ -133,7 +133,7 @@ def resume(
             "--config",
             help="With --into: the branch's config (the run's, plus features that start at or "
             "after the run's step: learning-rate decay, replay curation, fall-penalty ramp, "
-            "risk-averse actor; default: the run's own).",
+            "risk-averse actor, larger batch; default: the run's own).",
         ),
     ] = None,
     set_: Annotated[

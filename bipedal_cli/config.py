@@ -53,6 +53,12 @@ class AgentConfig:
     """Policy step where the decay ends (``lr_final`` from here on)."""
     batch_size: int = 64
     """Transitions per gradient step."""
+    batch_size_final: int | None = None
+    """Transitions per gradient step after ``batch_size_start``: a larger batch lowers the
+    gradient's noise where a smaller learning rate would slow the learning further. None:
+    ``batch_size`` throughout."""
+    batch_size_start: int = 0
+    """Policy step after which the updates draw ``batch_size_final`` transitions."""
     tau: float = 0.005
     """Polyak rate of the target critics: target <- tau * online + (1 - tau) * target."""
     n_critics: int = 5

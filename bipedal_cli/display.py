@@ -93,6 +93,8 @@ class TrainingDisplay:
             extra += ["fall penalty", _num(s["fall_penalty"], "{:.1f}")]
         if s.get("actor_cvar") is not None:  # agent.actor_cvar: the risk-averse actor
             extra += ["actor objective", f"CVaR {s['actor_cvar']:g}"]
+        if s.get("batch_size") is not None:  # agent.batch_size_final: a larger batch later
+            extra += ["batch", f"{s['batch_size']:,}"]
         if extra:
             table.add_row(*extra)
         return table
@@ -126,7 +128,8 @@ class TrainingDisplay:
                     if s.get("fall_penalty") is not None
                     else ""
                 )
-                + (f"  actor CVaR {s['actor_cvar']:g}" if s.get("actor_cvar") else ""),
+                + (f"  actor CVaR {s['actor_cvar']:g}" if s.get("actor_cvar") else "")
+                + (f"  batch {s['batch_size']}" if s.get("batch_size") else ""),
                 soft_wrap=True,
             )
 

@@ -1,6 +1,6 @@
 """Schedules over policy steps: constant, or linear over a window, for the learning rate and the
-fall penalty the learner sees; from a step on, for the actor's risk-averse objective and for
-the actor's learning at all.
+fall penalty the learner sees; from a step on, for the actor's risk-averse objective, the
+batch size and the actor's learning at all.
 
 rl-zoo's tuned TQC for BipedalWalkerHardcore-v3 decays its learning rate linearly over the run;
 ours is constant unless ``agent.lr_final`` is set. The fall penalty is constant unless
@@ -59,6 +59,18 @@ def actor_lowest_atoms(step: int, agent_cfg: Any) -> int | None:
     if a.actor_cvar is None or step <= a.actor_cvar_start:
         return None
     return max(1, math.floor(a.actor_cvar * a.n_critics * a.n_quantiles + 0.5))
+
+
+def batch_size_at(step: int, agent_cfg: Any) -> int:
+    """Transitions drawn by each update after policy step ``step``:
+
+    B(t) = batch_size          t <= batch_size_start, or batch_size_final None
+    B(t) = batch_size_final    t > batch_size_start
+    """
+    a = agent_cfg
+    if a.batch_size_final is None or step <= a.batch_size_start:
+        return a.batch_size
+    return a.batch_size_final
 
 
 def actor_frozen(step: int, agent_cfg: Any) -> bool:

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from .episodes import curation_keeps, curation_on
-from .schedule import actor_frozen, actor_lowest_atoms
+from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at
 
 
 def replay_kept_share(
@@ -60,6 +60,12 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         "actor_cvar": (
             trainer.cfg.agent.actor_cvar
             if actor_lowest_atoms(trainer.step, trainer.cfg.agent) is not None
+            else None
+        ),
+        # agent.batch_size_final: transitions per update, once a schedule changes them
+        "batch_size": (
+            batch_size_at(trainer.step, trainer.cfg.agent)
+            if trainer.cfg.agent.batch_size_final is not None
             else None
         ),
         **trainer.last_metrics,

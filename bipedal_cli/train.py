@@ -47,7 +47,8 @@ from .rundir import (
     write_config,
     write_plot,
 )
-from .schedule import actor_frozen, actor_lowest_atoms, fall_penalty_at, scheduled_learning_rate
+from .schedule import batch_size_at, fall_penalty_at
+from .scheduled_update import scheduled_updates
 from .signals import stop_on_signals
 from .snapshot import training_snapshot
 
@@ -160,7 +161,7 @@ class Trainer:
 
     def _loop(self, metrics: MetricsWriter, total: int, until_solved: bool) -> tuple[str, float]:
         """Policy steps and updates until the budget, a stop request or a solved test."""
-        cfg, t = self.cfg, self.cfg.train
+        t = self.cfg.train
         self.reporter.start(self.step, total)
         stopped = "budget"
         session_start = time.perf_counter()
@@ -176,16 +177,7 @@ class Trainer:
                     break
                 self._env_step(metrics, wall_base, session_start)
                 if self.learning():
-                    lr = scheduled_learning_rate(self.step, cfg.agent)
-                    if lr is not None:
-                        self.agent.set_learning_rate(lr)
-                    self.agent.actor_lowest_atoms = actor_lowest_atoms(self.step, cfg.agent)
-                    self.agent.actor_frozen = actor_frozen(self.step, cfg.agent)
-                    for _ in range(t.updates_per_step):
-                        batch = self.agent.batch_to_tensors(
-                            self.buffer.sample(cfg.agent.batch_size, self.rng)
-                        )
-                        self._update_metrics = self.agent.update(batch)
+                    self._update_metrics = scheduled_updates(self) or self._update_metrics
                 self.wall_time = wall_base + time.perf_counter() - session_start
                 if t.eval_every and self.step % t.eval_every == 0:
                     outcome = periodic_evaluation(self, metrics, until_solved)
@@ -207,7 +199,7 @@ class Trainer:
     def learning(self) -> bool:
         """Updates run after the warm-up, and after a restart's refill (``refill_until``)."""
         after = max(self.cfg.train.warmup_steps, self.refill_until)
-        return self.step > after and len(self.buffer) >= self.cfg.agent.batch_size
+        return self.step > after and len(self.buffer) >= batch_size_at(self.step, self.cfg.agent)
 
     def write_plot(self) -> Path | None:
         """``learning_curve.png`` in the run directory (skipped before the first episode ends)."""

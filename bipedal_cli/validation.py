@@ -79,6 +79,12 @@ def validate(cfg: Any, source: str) -> None:
         (a.n_layers <= 64, "agent.n_layers", "at most 64"),
         (a.n_critics * a.n_quantiles <= 1 << 20, "agent.n_critics", "N * M <= 2^20 atoms"),
         (a.batch_size <= 1 << 20, "agent.batch_size", "at most 2^20"),
+        (
+            a.batch_size_final is None or 1 <= a.batch_size_final <= 1 << 20,
+            "agent.batch_size_final",
+            "null or an integer in [1, 2^20]",
+        ),
+        (a.batch_size_start >= 0, "agent.batch_size_start", "a non-negative step"),
         (a.action_repeat >= 1, "agent.action_repeat", "a positive integer"),
         (a.history >= 1, "agent.history", "a positive integer"),
         (a.n_step >= 1, "agent.n_step", "a positive integer"),

@@ -145,6 +145,26 @@ def test_hardcore_lrdecay_cvar25_g99_is_its_seed_0_run_but_for_the_discount():
     assert g99 == cvar
 
 
+def test_hardcore_g99_b256_is_the_g99_run_until_its_batch_grows_at_1_944_373():
+    """Session 21's branch: the gamma-0.99 run where session 20 stopped it, with 256 transitions
+    per update from there; nothing else may differ, and the branch check accepts it from that run
+    at 1,944,373 but not from a step past it."""
+    from bipedal_cli.branch_rules import check_branch_config
+    from bipedal_cli.errors import UserError
+    from bipedal_cli.schedule import batch_size_at
+
+    g99, b256 = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-lrdecay-cvar25-g99", "hardcore-lrdecay-cvar25-g99-b256")
+    )
+    assert [batch_size_at(s, b256.agent) for s in (1_944_373, 1_944_374)] == [64, 256]
+    check_branch_config(g99, b256, 1_944_373, "hardcore-lrdecay-cvar25-g99-b256.yaml")
+    with pytest.raises(UserError, match="batch_size_start"):
+        check_branch_config(g99, b256, 1_944_374, "hardcore-lrdecay-cvar25-g99-b256.yaml")
+    b256.agent.batch_size_final, b256.agent.batch_size_start = None, 0
+    assert b256 == g99
+
+
 def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_282():
     """The pilot: seed 0's decaying run, branched where it stood when the key was added."""
     from bipedal_cli.branch_rules import check_branch_config

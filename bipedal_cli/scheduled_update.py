@@ -1,0 +1,31 @@
+"""The learning after one policy step: every schedule of :mod:`bipedal_cli.schedule` applied to
+the agent for that step, then ``train.updates_per_step`` TQC updates on fresh batches."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import torch
+
+from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at, scheduled_learning_rate
+
+
+def scheduled_updates(trainer: Any) -> Mapping[str, torch.Tensor] | None:
+    """The updates after policy step t = ``trainer.step``: learning rate lr(t), the actor's
+    lowest atoms L(t), whether the actor waits, and B(t) transitions drawn per update from the
+    replay buffer with the trainer's generator. Returns the last update's metrics (unsynced;
+    None when ``train.updates_per_step`` is 0)."""
+    agent, cfg, step = trainer.agent, trainer.cfg, trainer.step
+    lr = scheduled_learning_rate(step, cfg.agent)
+    if lr is not None:
+        agent.set_learning_rate(lr)
+    agent.actor_lowest_atoms = actor_lowest_atoms(step, cfg.agent)
+    agent.actor_frozen = actor_frozen(step, cfg.agent)
+    batch_size = batch_size_at(step, cfg.agent)
+    metrics = None
+    for _ in range(cfg.train.updates_per_step):
+        metrics = agent.update(
+            agent.batch_to_tensors(trainer.buffer.sample(batch_size, trainer.rng))
+        )
+    return metrics
