@@ -21,7 +21,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bipedal_cli.metrics import METRICS_FILE, read_metrics  # noqa: E402
+from bipedal_cli.metrics import COLUMNS, METRICS_FILE, read_metrics  # noqa: E402
 
 
 def evaluations(
@@ -53,7 +53,7 @@ def shared_rows(paths: list[Path], before: int) -> tuple[int, bool]:
     same in every run (wall times aside): a branch and its source must agree there."""
     tables = [
         [
-            tuple(v for k, v in r.items() if k != "wall_time")
+            tuple(r.get(k, "") for k in COLUMNS if k != "wall_time")  # newer columns: empty
             for r in read_metrics(p if p.is_file() else p / METRICS_FILE)
             if int(r["step"]) < before
         ]

@@ -51,6 +51,19 @@ DEFERRED = (
         lambda c: c.agent.batch_size_final is not None,
         lambda c: c.agent.batch_size_start,
     ),
+    (
+        (
+            "train.fall_restart",
+            "train.fall_restart_back",
+            "train.fall_restart_back_min",
+            "train.fall_restart_horizon",
+            "train.fall_restart_memory",
+            "train.fall_restart_start",
+        ),
+        "train.fall_restart_start",
+        lambda c: c.train.fall_restart > 0,
+        lambda c: c.train.fall_restart_start,
+    ),
     # the anchor pulls nothing while the actor waits: it is still the anchor itself
     (
         ("agent.actor_anchor", "agent.actor_anchor_kl"),
@@ -76,8 +89,8 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
     run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
     threads, budget and kept policies (they do not change the bits), and features that start
     at a policy step (DEFERRED: learning-rate decay, replay curation, fall-penalty ramp,
-    risk-averse actor, larger batch) as long as they change nothing before ``step``. One line
-    naming the first key that breaks this."""
+    risk-averse actor, larger batch, restarts near falls) as long as they change nothing before
+    ``step``. One line naming the first key that breaks this."""
     old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
     deferred_keys: set[str] = set()
     for keys, start_key, is_on, start in DEFERRED:
@@ -97,5 +110,6 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
             "change only device, train.threads, train.total_steps, train.keep_policies, "
             "train.refill_steps and "
             "features that start at or after the branch point (learning-rate decay, replay "
-            "curation, fall-penalty ramp, risk-averse actor, larger batch, actor anchor)"
+            "curation, fall-penalty ramp, risk-averse actor, larger batch, restarts near falls, "
+            "actor anchor)"
         )

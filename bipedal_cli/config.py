@@ -180,6 +180,25 @@ class TrainConfig:
     init_policy_sha256: str | None = None
     """The sha256 of ``init_policy``'s bytes, checked when the run starts, so that a config
     names one file's content, not whatever lies at that path. null: not checked."""
+    fall_restart: float = 0.0
+    """Training only: the probability that an episode, instead of starting afresh, restarts a
+    little before where a recent episode fell (the same terrain, its actions replayed up to
+    there, nothing stored), so that the learner sees more of what it falls at. 0: off."""
+    fall_restart_back: int = 30
+    """A restart begins k policy steps before the fall, k drawn uniformly from
+    ``fall_restart_back_min`` .. this."""
+    fall_restart_back_min: int = 1
+    """The least k: closer to a fall than a few policy steps, no action saves the walker, and a
+    restart there only repeats the fall."""
+    fall_restart_horizon: int | None = 100
+    """Policy steps a restarted episode plays before it is cut (a truncation: the value
+    bootstraps); null: to the episode's own end."""
+    fall_restart_memory: int = 100
+    """The falls remembered to restart from: those of the last this-many fresh episodes that
+    fell (a restarted episode's fall is not remembered, so one hard spot cannot crowd out the
+    others)."""
+    fall_restart_start: int = 0
+    """Policy step after which episodes may restart, and falls are remembered."""
     refill_steps: int = 50_000
     """A run continued from a ``restart.pt`` (no replay buffer: ``bipedal resume FILE --into
     DIR``) first acts this many policy steps with its own actor, without updates, to refill the

@@ -76,6 +76,7 @@ def switch_env(trainer: Trainer, env_id: str, clear_buffer: bool) -> None:
     trainer.last_eval = trainer.full_eval = None
     trainer.recent_returns.clear()
     trainer.recent_falls.clear()
+    trainer.fall_memory.falls.clear()  # the previous env's falls: other terrain
     trainer.start_episode()
 
 

@@ -95,6 +95,8 @@ class TrainingDisplay:
             extra += ["actor objective", f"CVaR {s['actor_cvar']:g}"]
         if s.get("batch_size") is not None:  # agent.batch_size_final: a larger batch later
             extra += ["batch", f"{s['batch_size']:,}"]
+        if s.get("falls_remembered") is not None:  # train.fall_restart: restarts near falls
+            extra += ["falls remembered", f"{s['falls_remembered']:,}"]
         if extra:
             table.add_row(*extra)
         return table
@@ -129,7 +131,12 @@ class TrainingDisplay:
                     else ""
                 )
                 + (f"  actor CVaR {s['actor_cvar']:g}" if s.get("actor_cvar") else "")
-                + (f"  batch {s['batch_size']}" if s.get("batch_size") else ""),
+                + (f"  batch {s['batch_size']}" if s.get("batch_size") else "")
+                + (
+                    f"  falls remembered {s['falls_remembered']}"
+                    if s.get("falls_remembered") is not None
+                    else ""
+                ),
                 soft_wrap=True,
             )
 

@@ -40,6 +40,8 @@ class EpisodeState:
     env_steps: int = 0  # env steps (action repeat: several per action)
     curated: bool = False  # its transitions wait for its end, then are kept or dropped
     fall_penalty: float | None = None  # what the learner sees on a fall (None: the env's -100)
+    restart_at: int | None = None  # a restart near a fall: the actions replayed, not stored
+    restart_env_steps: int = 0  # and their env steps
 
 
 @dataclass
@@ -49,6 +51,7 @@ class FinishedEpisode:
     env_steps: int
     fell: bool
     stored: bool = True  # False: replay curation dropped its transitions
+    restart_env_steps: int | None = None  # a restart near a fall: the env steps replayed
 
 
 class EpisodeRunner:
@@ -83,21 +86,45 @@ class EpisodeRunner:
         self.env.close()
         self.env = self._make_env()  # follows cfg.env, which a curriculum switches
 
-    def start(self, seed: int, curated: bool, fall_penalty: float | None) -> None:
+    def start(
+        self,
+        seed: int,
+        curated: bool,
+        fall_penalty: float | None,
+        prefix: np.ndarray | None = None,
+    ) -> None:
         """A new episode on a new env reset with ``seed``; ``curated`` and ``fall_penalty`` hold
         to its end (:func:`curation_on` and :func:`~bipedal_cli.schedule.fall_penalty_at` at
-        the step it starts)."""
+        the step it starts). With ``prefix`` (a restart near a fall,
+        :mod:`bipedal_cli.fall_restarts`) those actions are replayed first and nothing of them
+        is stored: the learner takes over after them."""
         self.episode = EpisodeState(seed=seed, curated=curated, fall_penalty=fall_penalty)
         self._fresh_env()
         obs, _ = self.env.reset(seed=seed)
         self.obs = obs.astype(np.float32)
         self.staged = []
+        if prefix is not None:
+            for action in prefix:
+                next_obs, reward, _, _, info = self.env.step(action)
+                self._account(action, reward, info)
+                self.obs = next_obs.astype(np.float32)
+            e = self.episode
+            e.restart_at, e.restart_env_steps = len(prefix), e.env_steps
         if self.nstep is not None:
             self.nstep.reset()
+
+    def _cut(self, truncated: bool) -> bool:
+        """A restarted episode is truncated ``train.fall_restart_horizon`` policy steps after it
+        took over (counting the step being taken)."""
+        e, horizon = self.episode, self.cfg.train.fall_restart_horizon
+        if e.restart_at is None or horizon is None:
+            return truncated
+        return truncated or len(e.actions) + 1 - e.restart_at >= horizon
 
     def step(self, action: np.ndarray) -> FinishedEpisode | None:
         """One policy step: env step(s), the transition stored; the result when it ended."""
         next_obs, reward, terminated, truncated, info = self.env.step(action)
+        truncated = self._cut(truncated)
         self._store(action, reward, next_obs, terminated, truncated)
         self._account(action, reward, info)
         self.obs = next_obs.astype(np.float32)
@@ -110,7 +137,8 @@ class EpisodeRunner:
                 for transition in self.staged:
                     self.buffer.add(*transition)
             self.staged = []
-            return FinishedEpisode(e.ret, e.env_ret, e.env_steps, fell, stored)
+            replayed = None if e.restart_at is None else e.restart_env_steps
+            return FinishedEpisode(e.ret, e.env_ret, e.env_steps, fell, stored, replayed)
         return None
 
     def _account(self, action: np.ndarray, reward: float, info: dict) -> None:
@@ -142,13 +170,17 @@ class EpisodeRunner:
         expected_obs: np.ndarray,
         curated: bool,
         fall_penalty: float | None,
+        restart_at: int | None = None,
     ) -> bool:
         """Rebuild an interrupted episode (its transitions are in the buffer already, or, when
-        curated, staged again); False when the rebuilt observation differs from
+        curated, staged again; a restart's first ``restart_at`` actions are replayed as its
+        start replayed them); False when the rebuilt observation differs from
         ``expected_obs``."""
-        self.start(seed, curated, fall_penalty)
-        for action in actions:
+        prefix = None if restart_at is None else actions[:restart_at]
+        self.start(seed, curated, fall_penalty, prefix)
+        for action in actions[restart_at or 0 :]:
             next_obs, reward, terminated, truncated, info = self.env.step(action)
+            truncated = self._cut(truncated)
             if curated:
                 self._store(action, reward, next_obs, terminated, truncated)
             elif self.nstep is not None:  # the pending steps only; what it returns is stored
@@ -167,5 +199,6 @@ class EpisodeRunner:
             "ret": e.ret,  # rebuilt by replay; kept as older versions read it
             "curated": e.curated,
             "fall_penalty": e.fall_penalty,
+            "restart_at": e.restart_at,
             "obs": None if self.obs is None else torch.from_numpy(self.obs.copy()),
         }

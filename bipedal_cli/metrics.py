@@ -15,7 +15,7 @@ from .errors import UserError
 from .paths import atomic_path
 
 COLUMNS = [
-    "kind",  # episode | eval | full_eval
+    "kind",  # episode | restart (train.fall_restart: begun near a fall) | eval | full_eval
     "stage",  # env id the row was produced on
     "step",  # policy steps so far (transitions stored)
     "episode",  # finished training episodes so far
@@ -32,7 +32,9 @@ COLUMNS = [
     "shaped_return",  # training episodes: the return the learner saw (train.fall_penalty and
     # train.reward_scale); "return" is always the env's own reward
     "env_steps",  # env steps so far ("step" counts policy steps; they differ with action repeat)
+    "restart_from",  # restart rows: the env steps replayed before the learner took over
 ]
+KINDS = ("episode", "restart", "eval", "full_eval")
 METRICS_FILE = "metrics.csv"
 
 
@@ -103,6 +105,6 @@ def _complete(row: dict) -> bool:
     if None in row or any(v is None for v in row.values()):  # too many or too few fields
         return False
     try:
-        return math.isfinite(float(row["step"])) and row["kind"] in ("episode", "eval", "full_eval")
+        return math.isfinite(float(row["step"])) and row["kind"] in KINDS
     except (KeyError, ValueError):
         return False

@@ -34,7 +34,12 @@ def run_state(trainer: Any, replay: bool = True) -> dict[str, Any]:
     buffer = trainer.buffer.state_dict() if replay else empty_buffer_state(trainer.buffer)
     episode = trainer.runner.state_dict(trainer.act_dim)
     if not replay:
-        episode = {**episode, "obs": None, "actions": torch.zeros(0, trainer.act_dim)}
+        episode = {
+            **episode,
+            "obs": None,
+            "actions": torch.zeros(0, trainer.act_dim),
+            "restart_at": None,
+        }
     return {
         "format": TRAIN_FORMAT,
         "version": FORMAT_VERSION,
@@ -56,6 +61,7 @@ def run_state(trainer: Any, replay: bool = True) -> dict[str, Any]:
         "episode": episode,
         "recent_returns": list(trainer.recent_returns),
         "recent_falls": list(trainer.recent_falls),
+        "fall_memory": trainer.fall_memory.state_dict(),  # train.fall_restart
         "rng": {
             "numpy": trainer.rng.bit_generator.state,
             "torch": torch.get_rng_state(),
@@ -89,6 +95,7 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
     trainer.refill_until = int(c.get("refill_until", 0))  # since 2026-12-02
     trainer.recent_returns = deque(state["recent_returns"], maxlen=100)
     trainer.recent_falls = deque(map(bool, state.get("recent_falls", [])), maxlen=100)
+    trainer.fall_memory.load_state_dict(state.get("fall_memory"))  # since 2026-12-03
     trainer.rng.bit_generator.state = state["rng"]["numpy"]
     torch.set_rng_state(state["rng"]["torch"])
     if state["rng"].get("cuda") is not None and trainer.device.type == "cuda":
@@ -107,6 +114,7 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
             ep["obs"].numpy(),
             bool(ep.get("curated")),
             None if penalty is None else float(penalty),
+            ep.get("restart_at"),
         )
         if not rebuilt:
             trainer.reporter.log(

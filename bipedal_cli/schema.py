@@ -121,11 +121,30 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
         or not math.isfinite(penalty)
     ):
         raise _fail(where, "episode.fall_penalty", "should be null or a finite number")
+    restart_at = episode.get("restart_at")  # since 2026-12-03: a restart near a fall
+    if restart_at is not None and not (
+        type(restart_at) is int and 0 <= restart_at <= actions.shape[0]
+    ):
+        raise _fail(where, "episode.restart_at", f"should be null or in [0, {actions.shape[0]}]")
+    _check_fall_memory(data.get("fall_memory") or [], act_dim, where)
     _get(data, "rng", Mapping, where)
     _get(data, "recent_returns", list, where)
     if "recent_falls" in data:  # since 2026-11-24; older checkpoints start it empty
         _get(data, "recent_falls", list, where)
     return cfg
+
+
+def _check_fall_memory(falls: Any, act_dim: int, where: str) -> None:
+    """``train.fall_restart``'s remembered falls: env seeds and (steps, act_dim) actions."""
+    if not isinstance(falls, list):
+        raise _fail(where, "fall_memory", "should be a list")
+    for i, fall in enumerate(falls):
+        seed = _get(fall, "seed", int, where, f"fall_memory.{i}.")
+        actions = _get(fall, "actions", torch.Tensor, where, f"fall_memory.{i}.")
+        if not 0 <= seed < 2**31:
+            raise _fail(where, f"fall_memory.{i}.seed", "should be in [0, 2^31)")
+        if actions.dim() != 2 or actions.shape[1] != act_dim or not actions.is_floating_point():
+            raise _fail(where, f"fall_memory.{i}.actions", f"should be (steps, {act_dim}) floats")
 
 
 def _check_restart(data: dict, where: str) -> None:

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from .episodes import curation_keeps, curation_on
+from .fall_restarts import restarts_on
 from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at
 
 
@@ -68,5 +69,7 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
             if trainer.cfg.agent.batch_size_final is not None
             else None
         ),
+        # train.fall_restart: the falls that episodes may restart near
+        "falls_remembered": len(trainer.fall_memory) if restarts_on(t, trainer.step) else None,
         **trainer.last_metrics,
     }

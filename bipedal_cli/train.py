@@ -34,7 +34,9 @@ from .checkpoint import STATE_FILE, atomic_save, initial_actor_state
 from .config import Config
 from .devices import configure_threads, resolve_device
 from .envs import policy_dims
-from .episodes import EpisodeRunner, FinishedEpisode, curation_on
+from .episode_record import record_episode
+from .episodes import EpisodeRunner, curation_on
+from .fall_restarts import FallMemory, restarts_on
 from .metrics import METRICS_FILE, MetricsWriter
 from .periodic_eval import evaluate_on_eval_seeds, periodic_evaluation
 from .reporting import NullReporter, Reporter
@@ -85,6 +87,7 @@ class Trainer:
             cfg.train.buffer_size, self.obs_dim, self.act_dim, with_discount=cfg.agent.n_step > 1
         )
         self.runner = EpisodeRunner(cfg, self.buffer)
+        self.fall_memory = FallMemory(cfg.train.fall_restart_memory)  # train.fall_restart
         self.rng = np.random.default_rng(cfg.seed)
         self.step = 0  # policy steps
         self.env_steps = 0
@@ -206,9 +209,11 @@ class Trainer:
         return write_plot(self.run_dir) if self.episodes else None
 
     def start_episode(self) -> None:
+        """A fresh episode on a new seed, or a restart near a remembered fall."""
         t = self.cfg.train
-        seed = int(self.rng.integers(2**31 - 1))
-        self.runner.start(seed, curation_on(t, self.step), fall_penalty_at(self.step, t))
+        restart = self.fall_memory.draw(self.rng, t) if restarts_on(t, self.step) else None
+        seed, prefix = restart or (int(self.rng.integers(2**31 - 1)), None)
+        self.runner.start(seed, curation_on(t, self.step), fall_penalty_at(self.step, t), prefix)
 
     def _env_step(self, metrics: MetricsWriter, wall_base: float, session_start: float) -> None:
         t = self.cfg.train
@@ -223,28 +228,11 @@ class Trainer:
         self.step += 1
         self.env_steps += self.runner.episode.env_steps - env_steps_before
         if finished is not None:
-            self._finish_episode(finished, metrics, wall_base, session_start)
+            self.wall_time = wall_base + time.perf_counter() - session_start
+            record_episode(self, finished, metrics)
+            self.start_episode()
 
-    def _finish_episode(
-        self, ep: FinishedEpisode, metrics: MetricsWriter, wall_base: float, session_start: float
-    ) -> None:
-        self.episodes += 1
-        self.recent_returns.append(ep.env_ret)
-        self.recent_falls.append(bool(ep.fell))
-        self.wall_time = wall_base + time.perf_counter() - session_start
-        row = {
-            "kind": "episode",
-            "return": ep.env_ret,
-            "shaped_return": ep.ret,
-            "length": ep.env_steps,
-            "fell": ep.fell,
-            **self.row_counters(),
-            **self._loss_metrics(),
-        }
-        metrics.write(row)
-        self.start_episode()
-
-    def _loss_metrics(self) -> dict[str, float]:
+    def loss_metrics(self) -> dict[str, float]:
         m = self._update_metrics
         if m is None:
             return {}
@@ -263,7 +251,7 @@ class Trainer:
         }
 
     def snapshot(self, steps_per_s: float) -> dict[str, Any]:
-        self._loss_metrics()
+        self.loss_metrics()
         return training_snapshot(self, steps_per_s)
 
 

@@ -2,7 +2,13 @@ from pathlib import Path
 
 import pytest
 
-from bipedal_cli.config import Config, config_from_dict, parse_override, resolve_config
+from bipedal_cli.config import (
+    Config,
+    TrainConfig,
+    config_from_dict,
+    parse_override,
+    resolve_config,
+)
 from bipedal_cli.errors import UserError
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
@@ -28,6 +34,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar25-g99": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar25-g99-b256": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-lrdecay-cvar25-g99-restarts": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-kl100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
@@ -164,6 +171,34 @@ def test_hardcore_g99_b256_is_the_g99_run_until_its_batch_grows_at_1_944_373():
         check_branch_config(g99, b256, 1_944_374, "hardcore-lrdecay-cvar25-g99-b256.yaml")
     b256.agent.batch_size_final, b256.agent.batch_size_start = None, 0
     assert b256 == g99
+
+
+def test_the_restarts_config_is_the_gamma_099_run_with_restarts_after_1_944_373():
+    """Session 22's branch: the gamma-0.99 run where session 20 stopped it, with restarts near
+    falls after that step; nothing else may differ, and the branch check accepts it from that
+    run at 1,944,373 but not from a step past it."""
+    from bipedal_cli.branch_rules import check_branch_config
+    from bipedal_cli.errors import UserError
+    from bipedal_cli.fall_restarts import restarts_on
+
+    g99, restarts = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-lrdecay-cvar25-g99", "hardcore-lrdecay-cvar25-g99-restarts")
+    )
+    assert [restarts_on(restarts.train, s) for s in (1_944_373, 1_944_374)] == [False, True]
+    name = "hardcore-lrdecay-cvar25-g99-restarts.yaml"
+    check_branch_config(g99, restarts, 1_944_373, name)
+    with pytest.raises(UserError, match="fall_restart_start"):
+        check_branch_config(g99, restarts, 1_944_374, name)
+    t, plain = restarts.train, TrainConfig()
+    t.fall_restart, t.fall_restart_back = plain.fall_restart, plain.fall_restart_back
+    t.fall_restart_back_min = plain.fall_restart_back_min
+    t.fall_restart_horizon, t.fall_restart_memory = (
+        plain.fall_restart_horizon,
+        plain.fall_restart_memory,
+    )
+    t.fall_restart_start = plain.fall_restart_start
+    assert restarts == g99
 
 
 def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_282():
