@@ -21,7 +21,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bipedal_cli.metrics import COLUMNS, METRICS_FILE, read_metrics  # noqa: E402
+from bipedal_cli.metrics import COLUMNS, FRESH_KINDS, METRICS_FILE, read_metrics  # noqa: E402
 
 
 def evaluations(
@@ -36,11 +36,12 @@ def evaluations(
 
 
 def training_episodes(path: Path, first: int, last: int | None = None) -> tuple[int, float, float]:
-    """Training episodes ending after ``first`` (and at or before ``last``): count, mean env
-    return, fraction that fell."""
+    """Fresh training episodes (probes of the deterministic policy included, restarts near
+    falls not) ending after ``first`` (and at or before ``last``): count, mean env return,
+    fraction that fell."""
     rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
     end = last if last is not None else 1 << 62
-    mine = [r for r in rows if r["kind"] == "episode" and first < int(r["step"]) <= end]
+    mine = [r for r in rows if r["kind"] in FRESH_KINDS and first < int(r["step"]) <= end]
     if not mine:
         return 0, float("nan"), float("nan")
     returns = [float(r["return"]) for r in mine]

@@ -6,7 +6,8 @@ its metrics.csv (docs/hardcore.md, session 22).
 
 Per span: fresh episodes (count, share that fell), restarted episodes (count, share that fell
 again before their horizon, mean env steps replayed) and the share of the span's policy steps
-that restarts played. An episode's policy steps are its row's step less the previous training
+that restarts played; probes of the deterministic policy (``train.fall_restart_probe``) count as
+fresh episodes. An episode's policy steps are its row's step less the previous training
 episode's (fresh or restarted).
 """
 
@@ -27,7 +28,7 @@ def restart_spans(rows: list[dict], first: int, every: int) -> list[dict]:
     spans: dict[int, dict] = {}
     previous = None
     for r in rows:
-        if r["kind"] not in ("episode", "restart"):
+        if r["kind"] not in ("episode", "probe", "restart"):
             continue
         step = int(float(r["step"]))
         played = step - previous if previous is not None else 0

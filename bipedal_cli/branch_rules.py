@@ -58,6 +58,7 @@ DEFERRED = (
             "train.fall_restart_back_min",
             "train.fall_restart_horizon",
             "train.fall_restart_memory",
+            "train.fall_restart_probe",
             "train.fall_restart_start",
         ),
         "train.fall_restart_start",

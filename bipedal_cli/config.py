@@ -199,6 +199,12 @@ class TrainConfig:
     others)."""
     fall_restart_start: int = 0
     """Policy step after which episodes may restart, and falls are remembered."""
+    fall_restart_probe: float = 0.0
+    """The probability that a fresh episode (after ``fall_restart_start``) is a probe: played by
+    the deterministic policy, the one evaluations score, and stored like any other. Above 0,
+    only probes' falls are remembered, so restarts rebuild the falls that cost evaluations and
+    explore (with the stochastic policy) a little before them. 0: every fresh episode is
+    stochastic and any fresh fall is remembered."""
     refill_steps: int = 50_000
     """A run continued from a ``restart.pt`` (no replay buffer: ``bipedal resume FILE --into
     DIR``) first acts this many policy steps with its own actor, without updates, to refill the

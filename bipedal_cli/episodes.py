@@ -42,6 +42,7 @@ class EpisodeState:
     fall_penalty: float | None = None  # what the learner sees on a fall (None: the env's -100)
     restart_at: int | None = None  # a restart near a fall: the actions replayed, not stored
     restart_env_steps: int = 0  # and their env steps
+    probe: bool = False  # played by the deterministic policy (train.fall_restart_probe)
 
 
 @dataclass
@@ -52,6 +53,7 @@ class FinishedEpisode:
     fell: bool
     stored: bool = True  # False: replay curation dropped its transitions
     restart_env_steps: int | None = None  # a restart near a fall: the env steps replayed
+    probe: bool = False  # played by the deterministic policy
 
 
 class EpisodeRunner:
@@ -92,13 +94,17 @@ class EpisodeRunner:
         curated: bool,
         fall_penalty: float | None,
         prefix: np.ndarray | None = None,
+        probe: bool = False,
     ) -> None:
         """A new episode on a new env reset with ``seed``; ``curated`` and ``fall_penalty`` hold
         to its end (:func:`curation_on` and :func:`~bipedal_cli.schedule.fall_penalty_at` at
         the step it starts). With ``prefix`` (a restart near a fall,
         :mod:`bipedal_cli.fall_restarts`) those actions are replayed first and nothing of them
-        is stored: the learner takes over after them."""
-        self.episode = EpisodeState(seed=seed, curated=curated, fall_penalty=fall_penalty)
+        is stored: the learner takes over after them. A ``probe`` is played by the
+        deterministic policy (the trainer reads it from :attr:`episode`)."""
+        self.episode = EpisodeState(
+            seed=seed, curated=curated, fall_penalty=fall_penalty, probe=probe
+        )
         self._fresh_env()
         obs, _ = self.env.reset(seed=seed)
         self.obs = obs.astype(np.float32)
@@ -138,7 +144,7 @@ class EpisodeRunner:
                     self.buffer.add(*transition)
             self.staged = []
             replayed = None if e.restart_at is None else e.restart_env_steps
-            return FinishedEpisode(e.ret, e.env_ret, e.env_steps, fell, stored, replayed)
+            return FinishedEpisode(e.ret, e.env_ret, e.env_steps, fell, stored, replayed, e.probe)
         return None
 
     def _account(self, action: np.ndarray, reward: float, info: dict) -> None:
@@ -171,13 +177,14 @@ class EpisodeRunner:
         curated: bool,
         fall_penalty: float | None,
         restart_at: int | None = None,
+        probe: bool = False,
     ) -> bool:
         """Rebuild an interrupted episode (its transitions are in the buffer already, or, when
         curated, staged again; a restart's first ``restart_at`` actions are replayed as its
         start replayed them); False when the rebuilt observation differs from
         ``expected_obs``."""
         prefix = None if restart_at is None else actions[:restart_at]
-        self.start(seed, curated, fall_penalty, prefix)
+        self.start(seed, curated, fall_penalty, prefix, probe)
         for action in actions[restart_at or 0 :]:
             next_obs, reward, terminated, truncated, info = self.env.step(action)
             truncated = self._cut(truncated)
@@ -200,5 +207,6 @@ class EpisodeRunner:
             "curated": e.curated,
             "fall_penalty": e.fall_penalty,
             "restart_at": e.restart_at,
+            "probe": e.probe,
             "obs": None if self.obs is None else torch.from_numpy(self.obs.copy()),
         }

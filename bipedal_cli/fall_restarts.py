@@ -13,6 +13,12 @@ The replayed prefix is not stored: its transitions are in the buffer already.
 Only fresh episodes' falls are remembered (the last ``train.fall_restart_memory`` of them), so
 the restarts follow where the current policy falls on terrain it has not seen, and a spot it
 keeps failing at from a restart cannot crowd out the others. Evaluations are untouched.
+
+With ``train.fall_restart_probe`` q > 0, a fresh episode is, with probability q, a probe played
+by the deterministic policy (the one evaluations score), and only probes' falls are remembered:
+the stochastic policy's falls are mostly its noise's (session 22: from 45 policy steps back the
+deterministic policy avoided 98% of them), so restarts explore near the falls that cost the
+score instead.
 """
 
 from __future__ import annotations
@@ -28,6 +34,23 @@ def restarts_on(train: Any, step: int) -> bool:
     ending there is remembered): after ``train.fall_restart_start``, so that a run branched at
     that step is, up to it, the run it branches from."""
     return train.fall_restart > 0 and step > train.fall_restart_start
+
+
+def draws_probe(rng: np.random.Generator, train: Any, step: int) -> bool:
+    """Whether a fresh episode starting after policy ``step`` is a probe (the deterministic
+    policy's): with probability ``train.fall_restart_probe`` once restarts are on. Draws from
+    ``rng`` only then, so that a run without probes is unchanged to the bit."""
+    if not (restarts_on(train, step) and train.fall_restart_probe > 0):
+        return False
+    return bool(rng.random() < train.fall_restart_probe)
+
+
+def remembers_fall(train: Any, step: int, fresh: bool, probe: bool, fell: bool) -> bool:
+    """Whether a finished episode's fall is remembered for restarts: a fresh episode's, once
+    restarts are on, and with probes on (``train.fall_restart_probe`` > 0) only a probe's."""
+    if not (fresh and fell and restarts_on(train, step)):
+        return False
+    return probe or train.fall_restart_probe == 0
 
 
 def restart_length(fall_length: int, back: int) -> int:

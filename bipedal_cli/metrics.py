@@ -15,7 +15,8 @@ from .errors import UserError
 from .paths import atomic_path
 
 COLUMNS = [
-    "kind",  # episode | restart (train.fall_restart: begun near a fall) | eval | full_eval
+    "kind",  # episode | restart (train.fall_restart: begun near a fall) | probe (a fresh episode
+    # of the deterministic policy: train.fall_restart_probe) | eval | full_eval
     "stage",  # env id the row was produced on
     "step",  # policy steps so far (transitions stored)
     "episode",  # finished training episodes so far
@@ -34,7 +35,8 @@ COLUMNS = [
     "env_steps",  # env steps so far ("step" counts policy steps; they differ with action repeat)
     "restart_from",  # restart rows: the env steps replayed before the learner took over
 ]
-KINDS = ("episode", "restart", "eval", "full_eval")
+KINDS = ("episode", "restart", "probe", "eval", "full_eval")
+FRESH_KINDS = ("episode", "probe")  # training episodes begun afresh on a new seed
 METRICS_FILE = "metrics.csv"
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import UserError
-from .metrics import METRICS_FILE, read_metrics
+from .metrics import FRESH_KINDS, METRICS_FILE, read_metrics
 from .paths import atomic_path, printable
 
 PLOT_SUFFIXES = (".png", ".svg")
@@ -39,7 +39,7 @@ def load_run(run_dir: str | Path, label: str | None = None, metric: str = "retur
     try:
         rows = read_metrics(path)
         # losses and alpha are empty during warm-up: those episodes have nothing to plot
-        episodes = [r for r in rows if r["kind"] == "episode" and r[metric] != ""]
+        episodes = [r for r in rows if r["kind"] in FRESH_KINDS and r[metric] != ""]
         evals = [r for r in rows if r["kind"] in ("eval", "full_eval")]
         steps = np.array([_env_steps(r) for r in episodes])
         values = np.array([float(r[metric]) for r in episodes])

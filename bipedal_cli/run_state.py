@@ -115,6 +115,7 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
             bool(ep.get("curated")),
             None if penalty is None else float(penalty),
             ep.get("restart_at"),
+            bool(ep.get("probe")),  # since 2026-12-03: train.fall_restart_probe
         )
         if not rebuilt:
             trainer.reporter.log(

@@ -126,6 +126,8 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
         type(restart_at) is int and 0 <= restart_at <= actions.shape[0]
     ):
         raise _fail(where, "episode.restart_at", f"should be null or in [0, {actions.shape[0]}]")
+    if type(episode.get("probe", False)) is not bool:  # since 2026-12-03
+        raise _fail(where, "episode.probe", "should be true or false")
     _check_fall_memory(data.get("fall_memory") or [], act_dim, where)
     _get(data, "rng", Mapping, where)
     _get(data, "recent_returns", list, where)

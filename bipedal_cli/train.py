@@ -34,9 +34,9 @@ from .checkpoint import STATE_FILE, atomic_save, initial_actor_state
 from .config import Config
 from .devices import configure_threads, resolve_device
 from .envs import policy_dims
-from .episode_record import record_episode
-from .episodes import EpisodeRunner, curation_on
-from .fall_restarts import FallMemory, restarts_on
+from .episode_record import record_episode, start_episode
+from .episodes import EpisodeRunner
+from .fall_restarts import FallMemory
 from .metrics import METRICS_FILE, MetricsWriter
 from .periodic_eval import evaluate_on_eval_seeds, periodic_evaluation
 from .reporting import NullReporter, Reporter
@@ -49,7 +49,7 @@ from .rundir import (
     write_config,
     write_plot,
 )
-from .schedule import batch_size_at, fall_penalty_at
+from .schedule import batch_size_at
 from .scheduled_update import scheduled_updates
 from .signals import stop_on_signals
 from .snapshot import training_snapshot
@@ -209,18 +209,15 @@ class Trainer:
         return write_plot(self.run_dir) if self.episodes else None
 
     def start_episode(self) -> None:
-        """A fresh episode on a new seed, or a restart near a remembered fall."""
-        t = self.cfg.train
-        restart = self.fall_memory.draw(self.rng, t) if restarts_on(t, self.step) else None
-        seed, prefix = restart or (int(self.rng.integers(2**31 - 1)), None)
-        self.runner.start(seed, curation_on(t, self.step), fall_penalty_at(self.step, t), prefix)
+        """The next training episode (:func:`~bipedal_cli.episode_record.start_episode`)."""
+        start_episode(self)
 
     def _env_step(self, metrics: MetricsWriter, wall_base: float, session_start: float) -> None:
         t = self.cfg.train
         if self.step < t.warmup_steps and t.init_policy is None:
             action = self.rng.uniform(-1.0, 1.0, self.act_dim).astype(np.float32)
         else:
-            action = self.agent.act(self.runner.obs)
+            action = self.agent.act(self.runner.obs, deterministic=self.runner.episode.probe)
             if not np.isfinite(action).all():  # Box2D must never see a NaN action
                 raise diverged(self, "the policy's action")
         env_steps_before = self.runner.episode.env_steps

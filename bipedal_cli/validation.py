@@ -153,6 +153,7 @@ def validate(cfg: Any, source: str) -> None:
             "an integer in [1, 100,000]",
         ),
         (t.fall_restart_start >= 0, "train.fall_restart_start", "a non-negative step"),
+        (0 <= t.fall_restart_probe <= 1, "train.fall_restart_probe", "a probability in [0, 1]"),
         (t.reward_scale > 0, "train.reward_scale", "a positive number"),
         (t.total_steps >= 0, "train.total_steps", "a non-negative integer"),
         (t.warmup_steps >= 0, "train.warmup_steps", "a non-negative integer"),

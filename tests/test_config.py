@@ -1,5 +1,6 @@
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from bipedal_cli.config import (
@@ -10,6 +11,8 @@ from bipedal_cli.config import (
     resolve_config,
 )
 from bipedal_cli.errors import UserError
+from bipedal_cli.fall_restarts import draws_probe, restarts_on
+from bipedal_cli.schedule import batch_size_at
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
@@ -35,6 +38,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-g99": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar25-g99-b256": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar25-g99-restarts": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-lrdecay-cvar25-g99-probes": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-kl100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
@@ -153,52 +157,66 @@ def test_hardcore_lrdecay_cvar25_g99_is_its_seed_0_run_but_for_the_discount():
     assert g99 == cvar
 
 
-def test_hardcore_g99_b256_is_the_g99_run_until_its_batch_grows_at_1_944_373():
-    """Session 21's branch: the gamma-0.99 run where session 20 stopped it, with 256 transitions
-    per update from there; nothing else may differ, and the branch check accepts it from that run
-    at 1,944,373 but not from a step past it."""
+RESTART_KEYS = tuple(
+    f"train.fall_restart{s}" for s in ("", "_back", "_back_min", "_horizon", "_memory", "_start")
+)
+G99_BRANCHES = {
+    # config: (session, the key that starts it, the keys it changes, what it does from there)
+    "hardcore-lrdecay-cvar25-g99-b256": (
+        21,
+        "batch_size_start",
+        ("agent.batch_size_final", "agent.batch_size_start"),
+        lambda c, s: batch_size_at(s, c.agent),
+        (64, 256),
+    ),
+    "hardcore-lrdecay-cvar25-g99-restarts": (
+        22,
+        "fall_restart_start",
+        RESTART_KEYS,
+        lambda c, s: restarts_on(c.train, s),
+        (False, True),
+    ),
+    "hardcore-lrdecay-cvar25-g99-probes": (
+        23,
+        "fall_restart_start",
+        (*RESTART_KEYS, "train.fall_restart_probe"),
+        lambda c, s: draws_probe(np.random.default_rng(0), c.train, s),
+        (False, True),
+    ),
+}
+
+
+@pytest.mark.parametrize("name", sorted(G99_BRANCHES))
+def test_the_gamma_099_branches_are_that_run_until_1_944_373(name):
+    """Sessions 21-23's branches: the gamma-0.99 run where session 20 stopped it, with one
+    feature from the next step; nothing else may differ, and the branch check accepts each from
+    that run at 1,944,373 but not from a step past it."""
     from bipedal_cli.branch_rules import check_branch_config
-    from bipedal_cli.errors import UserError
-    from bipedal_cli.schedule import batch_size_at
 
-    g99, b256 = (
-        resolve_config(CONFIGS / f"{n}.yaml")
-        for n in ("hardcore-lrdecay-cvar25-g99", "hardcore-lrdecay-cvar25-g99-b256")
+    _, start_key, keys, feature, expected = G99_BRANCHES[name]
+    g99, new = (
+        resolve_config(CONFIGS / f"{n}.yaml") for n in ("hardcore-lrdecay-cvar25-g99", name)
     )
-    assert [batch_size_at(s, b256.agent) for s in (1_944_373, 1_944_374)] == [64, 256]
-    check_branch_config(g99, b256, 1_944_373, "hardcore-lrdecay-cvar25-g99-b256.yaml")
-    with pytest.raises(UserError, match="batch_size_start"):
-        check_branch_config(g99, b256, 1_944_374, "hardcore-lrdecay-cvar25-g99-b256.yaml")
-    b256.agent.batch_size_final, b256.agent.batch_size_start = None, 0
-    assert b256 == g99
+    assert tuple(feature(new, s) for s in (1_944_373, 1_944_374)) == expected
+    check_branch_config(g99, new, 1_944_373, f"{name}.yaml")
+    with pytest.raises(UserError, match=start_key):
+        check_branch_config(g99, new, 1_944_374, f"{name}.yaml")
+    plain = Config()
+    for key in keys:
+        section, field = key.split(".")
+        setattr(getattr(new, section), field, getattr(getattr(plain, section), field))
+    assert new == g99
 
 
-def test_the_restarts_config_is_the_gamma_099_run_with_restarts_after_1_944_373():
-    """Session 22's branch: the gamma-0.99 run where session 20 stopped it, with restarts near
-    falls after that step; nothing else may differ, and the branch check accepts it from that
-    run at 1,944,373 but not from a step past it."""
-    from bipedal_cli.branch_rules import check_branch_config
-    from bipedal_cli.errors import UserError
-    from bipedal_cli.fall_restarts import restarts_on
-
-    g99, restarts = (
-        resolve_config(CONFIGS / f"{n}.yaml")
-        for n in ("hardcore-lrdecay-cvar25-g99", "hardcore-lrdecay-cvar25-g99-restarts")
+def test_the_probes_config_is_the_restarts_config_but_for_its_probes():
+    """Session 23 changes one thing against session 22: where the remembered falls come from."""
+    probes, restarts = (
+        resolve_config(CONFIGS / f"hardcore-lrdecay-cvar25-g99-{n}.yaml")
+        for n in ("probes", "restarts")
     )
-    assert [restarts_on(restarts.train, s) for s in (1_944_373, 1_944_374)] == [False, True]
-    name = "hardcore-lrdecay-cvar25-g99-restarts.yaml"
-    check_branch_config(g99, restarts, 1_944_373, name)
-    with pytest.raises(UserError, match="fall_restart_start"):
-        check_branch_config(g99, restarts, 1_944_374, name)
-    t, plain = restarts.train, TrainConfig()
-    t.fall_restart, t.fall_restart_back = plain.fall_restart, plain.fall_restart_back
-    t.fall_restart_back_min = plain.fall_restart_back_min
-    t.fall_restart_horizon, t.fall_restart_memory = (
-        plain.fall_restart_horizon,
-        plain.fall_restart_memory,
-    )
-    t.fall_restart_start = plain.fall_restart_start
-    assert restarts == g99
+    assert probes.train.fall_restart_probe == 1.0
+    probes.train.fall_restart_probe = TrainConfig().fall_restart_probe
+    assert probes == restarts
 
 
 def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_282():
