@@ -21,6 +21,7 @@ def test_default_yaml_equals_the_dataclass_defaults():
     assert resolve_config(CONFIGS / "walker.yaml") == Config()
 
 
+HARDCORE_H4 = ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0)
 SHIPPED = {
     # name: (env, d2rl, action_repeat, history, n_step, fall_penalty, reward_scale)
     "walker": ("BipedalWalker-v3", True, 1, 1, 1, None, 1.0),
@@ -39,6 +40,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-g99-b256": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar25-g99-restarts": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-lrdecay-cvar25-g99-probes": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
+    "hardcore-lrdecay-cvar25-g99-probes-late": HARDCORE_H4,
     "hardcore-warm-anchor100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-anchor25": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
     "hardcore-warm-kl100": ("BipedalWalkerHardcore-v3", True, 3, 4, 3, -5.0, 5.0),
@@ -161,23 +163,30 @@ RESTART_KEYS = tuple(
     f"train.fall_restart{s}" for s in ("", "_back", "_back_min", "_horizon", "_memory", "_start")
 )
 G99_BRANCHES = {
-    # config: (session, the key that starts it, the keys it changes, what it does from there)
+    # config: (branch step, the key that starts it, the keys it changes, what it does from there)
     "hardcore-lrdecay-cvar25-g99-b256": (
-        21,
+        1_944_373,
         "batch_size_start",
         ("agent.batch_size_final", "agent.batch_size_start"),
         lambda c, s: batch_size_at(s, c.agent),
         (64, 256),
     ),
     "hardcore-lrdecay-cvar25-g99-restarts": (
-        22,
+        1_944_373,
         "fall_restart_start",
         RESTART_KEYS,
         lambda c, s: restarts_on(c.train, s),
         (False, True),
     ),
     "hardcore-lrdecay-cvar25-g99-probes": (
-        23,
+        1_944_373,
+        "fall_restart_start",
+        (*RESTART_KEYS, "train.fall_restart_probe"),
+        lambda c, s: draws_probe(np.random.default_rng(0), c.train, s),
+        (False, True),
+    ),
+    "hardcore-lrdecay-cvar25-g99-probes-late": (
+        2_157_722,  # session 24's control, restarted from the restart file
         "fall_restart_start",
         (*RESTART_KEYS, "train.fall_restart_probe"),
         lambda c, s: draws_probe(np.random.default_rng(0), c.train, s),
@@ -187,20 +196,20 @@ G99_BRANCHES = {
 
 
 @pytest.mark.parametrize("name", sorted(G99_BRANCHES))
-def test_the_gamma_099_branches_are_that_run_until_1_944_373(name):
-    """Sessions 21-23's branches: the gamma-0.99 run where session 20 stopped it, with one
+def test_the_gamma_099_branches_are_that_run_until_their_branch_step(name):
+    """Sessions 21-25's branches: the gamma-0.99 run where a session stopped it, with one
     feature from the next step; nothing else may differ, and the branch check accepts each from
-    that run at 1,944,373 but not from a step past it."""
+    that run at its branch step but not from a step past it."""
     from bipedal_cli.branch_rules import check_branch_config
 
-    _, start_key, keys, feature, expected = G99_BRANCHES[name]
+    step, start_key, keys, feature, expected = G99_BRANCHES[name]
     g99, new = (
         resolve_config(CONFIGS / f"{n}.yaml") for n in ("hardcore-lrdecay-cvar25-g99", name)
     )
-    assert tuple(feature(new, s) for s in (1_944_373, 1_944_374)) == expected
-    check_branch_config(g99, new, 1_944_373, f"{name}.yaml")
+    assert tuple(feature(new, s) for s in (step, step + 1)) == expected
+    check_branch_config(g99, new, step, f"{name}.yaml")
     with pytest.raises(UserError, match=start_key):
-        check_branch_config(g99, new, 1_944_374, f"{name}.yaml")
+        check_branch_config(g99, new, step + 1, f"{name}.yaml")
     plain = Config()
     for key in keys:
         section, field = key.split(".")
@@ -217,6 +226,18 @@ def test_the_probes_config_is_the_restarts_config_but_for_its_probes():
     assert probes.train.fall_restart_probe == 1.0
     probes.train.fall_restart_probe = TrainConfig().fall_restart_probe
     assert probes == restarts
+
+
+def test_the_late_probes_config_is_the_probes_config_but_for_its_start():
+    """Session 24's next step: the same probes, from the control restarted from the restart file."""
+    late, probes = (
+        resolve_config(CONFIGS / f"hardcore-lrdecay-cvar25-g99-{n}.yaml")
+        for n in ("probes-late", "probes")
+    )
+    starts = (late.train.fall_restart_start, probes.train.fall_restart_start)
+    assert starts == (2_157_722, 1_944_373)
+    late.train.fall_restart_start = probes.train.fall_restart_start
+    assert late == probes
 
 
 def test_hardcore_lrdecay_cvar_late_is_the_branch_of_the_decaying_run_at_1_728_282():
