@@ -52,6 +52,12 @@ DEFERRED = (
         lambda c: c.agent.batch_size_start,
     ),
     (
+        ("train.updates_per_step_final", "train.updates_per_step_start"),
+        "train.updates_per_step_start",
+        lambda c: c.train.updates_per_step_final is not None,
+        lambda c: c.train.updates_per_step_start,
+    ),
+    (
         (
             "train.fall_restart",
             "train.fall_restart_back",

@@ -12,7 +12,7 @@ from typing import Annotated
 import typer
 
 from .cli_common import EnvOpt, console
-from .config import canonical_env_id
+from .env_ids import canonical_env_id
 from .errors import UserError
 from .paths import check_output_path, printable
 from .validation import check_count, check_seeds

@@ -11,7 +11,8 @@ from rich import box
 from rich.table import Table
 
 from .cli_common import console
-from .config import canonical_env_id, resolve_config
+from .config import resolve_config
+from .env_ids import canonical_env_id
 from .errors import UserError
 from .paths import check_output_path, printable
 from .validation import check_count, check_seeds

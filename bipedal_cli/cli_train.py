@@ -10,7 +10,8 @@ from typing import Annotated
 import typer
 
 from .cli_common import DeviceOpt, EnvOpt, console
-from .config import canonical_env_id, resolve_config
+from .config import resolve_config
+from .env_ids import canonical_env_id
 from .errors import UserError
 from .paths import printable
 

@@ -14,25 +14,9 @@ from pathlib import Path
 from typing import Any
 
 from .config_yaml import load_yaml, parse_override, set_nested
-from .errors import UserError
+from .env_ids import canonical_env_id
 from .typed_fill import fill_dataclass
 from .validation import validate
-
-ENV_ALIASES = {
-    "walker": "BipedalWalker-v3",
-    "hardcore": "BipedalWalkerHardcore-v3",
-}
-KNOWN_ENVS = tuple(ENV_ALIASES.values())
-
-
-def canonical_env_id(name: str, option: str = "--env") -> str:
-    """Map ``walker``/``hardcore`` or a full Gymnasium id to the full id; reject anything else."""
-    if name in ENV_ALIASES:
-        return ENV_ALIASES[name]
-    if name in KNOWN_ENVS:
-        return name
-    expected = ", ".join([*ENV_ALIASES, *KNOWN_ENVS])
-    raise UserError(f"{option}: unknown environment {name!r}; expected one of {expected}")
 
 
 @dataclass
@@ -128,7 +112,12 @@ class TrainConfig:
     buffer_size: int = 1_000_000
     """Replay buffer capacity in transitions."""
     updates_per_step: int = 1
-    """Gradient steps per env step after warm-up (UTD ratio)."""
+    """Gradient steps per policy step after warm-up (UTD ratio)."""
+    updates_per_step_final: int | None = None
+    """Gradient steps per policy step after ``updates_per_step_start``: more learning from the
+    same experience (REDQ's lever; costs that many updates' time). None: ``updates_per_step``."""
+    updates_per_step_start: int = 0
+    """Policy step after which each step makes ``updates_per_step_final`` updates."""
     eval_every: int = 5_000
     """Policy steps between periodic deterministic evaluations (0: never)."""
     eval_episodes: int = 5

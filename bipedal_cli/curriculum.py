@@ -13,7 +13,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .config import ENV_ALIASES, Config
+from .config import Config
+from .env_ids import ENV_ALIASES
 from .envs import policy_dims
 from .errors import UserError
 from .reporting import Reporter

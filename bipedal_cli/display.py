@@ -95,10 +95,12 @@ class TrainingDisplay:
             extra += ["actor objective", f"CVaR {s['actor_cvar']:g}"]
         if s.get("batch_size") is not None:  # agent.batch_size_final: a larger batch later
             extra += ["batch", f"{s['batch_size']:,}"]
+        if s.get("updates_per_step") is not None:  # train.updates_per_step_final
+            extra += ["updates/step", f"{s['updates_per_step']}"]
         if s.get("falls_remembered") is not None:  # train.fall_restart: restarts near falls
             extra += ["falls remembered", f"{s['falls_remembered']:,}"]
-        if extra:
-            table.add_row(*extra)
+        for first in range(0, len(extra), 8):  # four label-value pairs a row
+            table.add_row(*extra[first : first + 8])
         return table
 
     # Reporter protocol
@@ -132,6 +134,11 @@ class TrainingDisplay:
                 )
                 + (f"  actor CVaR {s['actor_cvar']:g}" if s.get("actor_cvar") else "")
                 + (f"  batch {s['batch_size']}" if s.get("batch_size") else "")
+                + (
+                    f"  updates/step {s['updates_per_step']}"
+                    if s.get("updates_per_step") is not None
+                    else ""
+                )
                 + (
                     f"  falls remembered {s['falls_remembered']}"
                     if s.get("falls_remembered") is not None

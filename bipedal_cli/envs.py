@@ -23,7 +23,7 @@ from collections.abc import Callable
 import gymnasium as gym
 import numpy as np
 
-from .config import canonical_env_id
+from .env_ids import canonical_env_id
 
 FALL_REWARD = -100.0  # BipedalWalker's reward on the step where the hull touches the ground
 

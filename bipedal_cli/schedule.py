@@ -68,9 +68,22 @@ def batch_size_at(step: int, agent_cfg: Any) -> int:
     B(t) = batch_size_final    t > batch_size_start
     """
     a = agent_cfg
-    if a.batch_size_final is None or step <= a.batch_size_start:
-        return a.batch_size
-    return a.batch_size_final
+    return _switched(step, a.batch_size_start, a.batch_size, a.batch_size_final)
+
+
+def updates_at(step: int, train_cfg: Any) -> int:
+    """TQC updates made after policy step ``step`` (the update-to-data ratio):
+
+    U(t) = updates_per_step          t <= updates_per_step_start, or updates_per_step_final None
+    U(t) = updates_per_step_final    t > updates_per_step_start
+    """
+    t = train_cfg
+    return _switched(step, t.updates_per_step_start, t.updates_per_step, t.updates_per_step_final)
+
+
+def _switched(step: int, start: int, before: int, after: int | None) -> int:
+    """``before`` up to policy step ``start`` (always, when ``after`` is None), then ``after``."""
+    return before if after is None or step <= start else after
 
 
 def actor_frozen(step: int, agent_cfg: Any) -> bool:

@@ -1,5 +1,6 @@
 """The learning after one policy step: every schedule of :mod:`bipedal_cli.schedule` applied to
-the agent for that step, then ``train.updates_per_step`` TQC updates on fresh batches."""
+the agent for that step, then U(t) TQC updates on fresh batches (``train.updates_per_step``, or
+``train.updates_per_step_final`` after its step)."""
 
 from __future__ import annotations
 
@@ -8,14 +9,20 @@ from typing import Any
 
 import torch
 
-from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at, scheduled_learning_rate
+from .schedule import (
+    actor_frozen,
+    actor_lowest_atoms,
+    batch_size_at,
+    scheduled_learning_rate,
+    updates_at,
+)
 
 
 def scheduled_updates(trainer: Any) -> Mapping[str, torch.Tensor] | None:
     """The updates after policy step t = ``trainer.step``: learning rate lr(t), the actor's
-    lowest atoms L(t), whether the actor waits, and B(t) transitions drawn per update from the
-    replay buffer with the trainer's generator. Returns the last update's metrics (unsynced;
-    None when ``train.updates_per_step`` is 0)."""
+    lowest atoms L(t), whether the actor waits, then U(t) updates of B(t) transitions each,
+    drawn from the replay buffer with the trainer's generator. Returns the last update's
+    metrics (unsynced; None when U(t) is 0)."""
     agent, cfg, step = trainer.agent, trainer.cfg, trainer.step
     lr = scheduled_learning_rate(step, cfg.agent)
     if lr is not None:
@@ -24,7 +31,7 @@ def scheduled_updates(trainer: Any) -> Mapping[str, torch.Tensor] | None:
     agent.actor_frozen = actor_frozen(step, cfg.agent)
     batch_size = batch_size_at(step, cfg.agent)
     metrics = None
-    for _ in range(cfg.train.updates_per_step):
+    for _ in range(updates_at(step, cfg.train)):
         metrics = agent.update(
             agent.batch_to_tensors(trainer.buffer.sample(batch_size, trainer.rng))
         )

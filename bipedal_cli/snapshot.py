@@ -10,7 +10,7 @@ import numpy as np
 
 from .episodes import curation_keeps, curation_on
 from .fall_restarts import restarts_on
-from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at
+from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at, updates_at
 
 
 def replay_kept_share(
@@ -68,6 +68,10 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
             batch_size_at(trainer.step, trainer.cfg.agent)
             if trainer.cfg.agent.batch_size_final is not None
             else None
+        ),
+        # train.updates_per_step_final: updates per policy step, once a schedule changes them
+        "updates_per_step": (
+            updates_at(trainer.step, t) if t.updates_per_step_final is not None else None
         ),
         # train.fall_restart: the falls that episodes may restart near
         "falls_remembered": len(trainer.fall_memory) if restarts_on(t, trainer.step) else None,

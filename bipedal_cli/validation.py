@@ -160,6 +160,12 @@ def validate(cfg: Any, source: str) -> None:
         (t.refill_steps >= 0, "train.refill_steps", "a non-negative integer"),
         (t.buffer_size >= 1, "train.buffer_size", "a positive integer"),
         (t.updates_per_step >= 0, "train.updates_per_step", "a non-negative integer"),
+        (
+            t.updates_per_step_final is None or 0 <= t.updates_per_step_final <= 64,
+            "train.updates_per_step_final",
+            "an integer in [0, 64] or null",
+        ),
+        (t.updates_per_step_start >= 0, "train.updates_per_step_start", "a non-negative step"),
         (t.eval_every >= 0, "train.eval_every", "a non-negative integer"),
         (t.eval_episodes >= 1, "train.eval_episodes", "a positive integer"),
         (t.solved_episodes >= 1, "train.solved_episodes", "a positive integer"),

@@ -12,7 +12,7 @@ from bipedal_cli.config import (
 )
 from bipedal_cli.errors import UserError
 from bipedal_cli.fall_restarts import draws_probe, restarts_on
-from bipedal_cli.schedule import batch_size_at
+from bipedal_cli.schedule import batch_size_at, updates_at
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
@@ -42,6 +42,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-g99-restarts": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-g99-probes": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-g99-probes-late": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-g99-utd2": HARDCORE_H4,
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
     "hardcore-warm-kl100": HARDCORE_H4,
@@ -193,12 +194,19 @@ G99_BRANCHES = {
         lambda c, s: draws_probe(np.random.default_rng(0), c.train, s),
         (False, True),
     ),
+    "hardcore-lrdecay-cvar25-g99-utd2": (
+        2_464_591,  # session 25's control, where it stopped
+        "updates_per_step_start",
+        ("train.updates_per_step_final", "train.updates_per_step_start"),
+        lambda c, s: updates_at(s, c.train),
+        (1, 2),
+    ),
 }
 
 
 @pytest.mark.parametrize("name", sorted(G99_BRANCHES))
 def test_the_gamma_099_branches_are_that_run_until_their_branch_step(name):
-    """Sessions 21-24's branches: the gamma-0.99 run where a session stopped it, with one
+    """Sessions 21-25's branches: the gamma-0.99 run where a session stopped it, with one
     feature from the next step; nothing else may differ, and the branch check accepts each from
     that run at its branch step but not from a step past it."""
     from bipedal_cli.branch_rules import check_branch_config
