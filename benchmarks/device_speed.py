@@ -1,0 +1,139 @@
+"""Training speed of a run's config on each device, at its batch and update ratio and at the
+larger ones a GPU might afford: policy steps/s of full training and updates/s alone.
+
+    python benchmarks/device_speed.py --config configs/hardcore-lrdecay-cvar25-g99.yaml \
+        --devices cuda cpu --variants 64x1 256x1 64x2 --steps 1000
+
+A variant BxU is U gradient updates of B transitions per policy step. Every measurement runs in
+its own subprocess (clean threads, one CUDA context), after ``--warmup`` random policy steps
+that are not timed; the run's risk-averse actor objective (``agent.actor_cvar``) is switched on
+from the start so that each update is a late-run one. "policy steps/s" is full training: the
+environment (with the config's action repeat), the replay buffer and U updates per step.
+"updates/s alone" draws the batches beforehand. CPU measurements use ``--cpu-threads``.
+The printed lines and the machine go to benchmarks/results/device_speed-<date>.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+
+from record import run_recorded
+
+
+def measure(
+    config: str, device: str, batch: int, updates: int, steps: int, warmup: int, threads: int
+) -> dict:
+    import numpy as np
+    import torch
+
+    from bipedal_cli.config import resolve_config
+    from bipedal_cli.reporting import NullReporter
+    from bipedal_cli.train import Trainer
+
+    overrides = {
+        "device": device,
+        "agent.batch_size": batch,
+        "agent.actor_cvar_start": 0,
+        "train.updates_per_step": updates,
+        "train.warmup_steps": warmup,
+        "train.eval_every": 0,
+        "train.checkpoint_every": 0,
+        "train.keep_policies": False,
+        "train.threads": threads,
+        "train.buffer_size": 100_000,
+    }
+    cfg = resolve_config(config, [f"{k}={v}" for k, v in overrides.items()])
+    sync = torch.cuda.synchronize if device.startswith("cuda") else (lambda: None)
+
+    class Clock(NullReporter):
+        marks: list[tuple[int, float]] = []
+
+        def update(self, snapshot):
+            sync()
+            self.marks.append((snapshot["step"], time.perf_counter()))
+
+    clock = Clock()
+    trainer = Trainer(cfg, tempfile.mkdtemp(prefix="bipedal-speed-"), clock)
+    trainer.run(total_steps=warmup + 100 + steps)
+    timed = [(s, t) for s, t in clock.marks if s >= warmup + 100]
+    (s0, t0), (s1, t1) = timed[0], timed[-2]  # the last mark comes after the final save
+
+    rng = np.random.default_rng(0)
+    agent = trainer.agent
+    batches = [agent.batch_to_tensors(trainer.buffer.sample(batch, rng)) for _ in range(steps)]
+    sync()
+    start = time.perf_counter()
+    for b in batches:
+        agent.update(b)
+    agent.sync()
+    sync()
+    return {
+        "policy_steps_per_s": (s1 - s0) / (t1 - t0),
+        "updates_per_s": len(batches) / (time.perf_counter() - start),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--config", default="configs/hardcore-lrdecay-cvar25-g99.yaml")
+    parser.add_argument("--devices", nargs="+", default=["cuda", "cpu"])
+    parser.add_argument("--variants", nargs="+", default=["64x1", "256x1", "64x2"])
+    parser.add_argument("--cpu-variants", nargs="+", default=["64x1"])
+    parser.add_argument("--steps", type=int, default=1000, help="timed policy steps")
+    parser.add_argument("--warmup", type=int, default=1000)
+    parser.add_argument("--cpu-threads", type=int, default=1)
+    parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)  # device batch updates
+    args = parser.parse_args()
+    if args.child:
+        device, batch, updates = args.child[0], int(args.child[1]), int(args.child[2])
+        threads = args.cpu_threads if device == "cpu" else 1
+        out = measure(args.config, device, batch, updates, args.steps, args.warmup, threads)
+        print("RESULT " + json.dumps(out))
+        return
+
+    print(f"config {args.config}, {args.steps} timed policy steps after {args.warmup} warm-up")
+    print("| device | batch x updates/step | policy steps/s | updates/s alone |")
+    print("|---|---|---|---|")
+    for device in args.devices:
+        for variant in args.cpu_variants if device == "cpu" else args.variants:
+            batch, updates = variant.split("x")
+            cmd = [
+                sys.executable,
+                __file__,
+                "--config",
+                args.config,
+                "--steps",
+                str(args.steps),
+                "--warmup",
+                str(args.warmup),
+                "--cpu-threads",
+                str(args.cpu_threads),
+                "--child",
+                device,
+                batch,
+                updates,
+            ]
+            proc = subprocess.run(cmd, capture_output=True, text=True)
+            lines = [x for x in proc.stdout.splitlines() if x.startswith("RESULT ")]
+            if not lines:
+                print(f"| {device} | {variant} | failed: {proc.stderr.strip()[-300:]} | |")
+                continue
+            r = json.loads(lines[-1][len("RESULT ") :])
+            name = f"{device} ({args.cpu_threads} thread)" if device == "cpu" else device
+            print(
+                f"| {name} | {batch} x {updates} | {r['policy_steps_per_s']:.1f} "
+                f"| {r['updates_per_s']:.1f} |",
+                flush=True,
+            )
+
+
+if __name__ == "__main__":
+    if "--child" in sys.argv:
+        main()
+    else:
+        run_recorded("device_speed", main)
