@@ -21,8 +21,29 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 
 from record import run_recorded
+
+from bipedal_cli.reporting import NullReporter
+
+
+class Clock(NullReporter):
+    """A reporter that notes when each of the loop's reports (every 50 steps) came."""
+
+    def __init__(self, sync: Callable[[], None] = lambda: None) -> None:
+        self.sync, self.marks = sync, []
+
+    def update(self, snapshot) -> None:
+        self.sync()  # on a GPU, the work queued so far is part of the span
+        self.marks.append((snapshot["step"], time.perf_counter()))
+
+    def steps_per_s(self, first_timed: int) -> float:
+        """Steps per second from the first report at or after ``first_timed`` to the one before
+        the last: the last comes after the final save."""
+        timed = [(s, t) for s, t in self.marks if s >= first_timed]
+        (s0, t0), (s1, t1) = timed[0], timed[-2]
+        return (s1 - s0) / (t1 - t0)
 
 
 def measure(
@@ -32,7 +53,6 @@ def measure(
     import torch
 
     from bipedal_cli.config import resolve_config
-    from bipedal_cli.reporting import NullReporter
     from bipedal_cli.train import Trainer
 
     overrides = {
@@ -49,19 +69,10 @@ def measure(
     }
     cfg = resolve_config(config, [f"{k}={v}" for k, v in overrides.items()])
     sync = torch.cuda.synchronize if device.startswith("cuda") else (lambda: None)
-
-    class Clock(NullReporter):
-        marks: list[tuple[int, float]] = []
-
-        def update(self, snapshot):
-            sync()
-            self.marks.append((snapshot["step"], time.perf_counter()))
-
-    clock = Clock()
+    clock = Clock(sync)
     trainer = Trainer(cfg, tempfile.mkdtemp(prefix="bipedal-speed-"), clock)
     trainer.run(total_steps=warmup + 100 + steps)
-    timed = [(s, t) for s, t in clock.marks if s >= warmup + 100]
-    (s0, t0), (s1, t1) = timed[0], timed[-2]  # the last mark comes after the final save
+    train_sps = clock.steps_per_s(warmup + 100)
 
     rng = np.random.default_rng(0)
     agent = trainer.agent
@@ -73,7 +84,7 @@ def measure(
     agent.sync()
     sync()
     return {
-        "policy_steps_per_s": (s1 - s0) / (t1 - t0),
+        "policy_steps_per_s": train_sps,
         "updates_per_s": len(batches) / (time.perf_counter() - start),
     }
 

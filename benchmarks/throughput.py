@@ -30,6 +30,7 @@ import time
 WARMUP = 1000
 
 
+from device_speed import Clock  # noqa: E402
 from record import cpu_name  # noqa: E402
 
 
@@ -43,7 +44,6 @@ def measure_ours(threads: int, steps: int, device: str, eval_episodes: int, spli
 
     from bipedal_cli.config import config_from_dict
     from bipedal_cli.evaluation import evaluate_actor
-    from bipedal_cli.reporting import NullReporter
     from bipedal_cli.train import Trainer
 
     cfg = config_from_dict(
@@ -60,22 +60,11 @@ def measure_ours(threads: int, steps: int, device: str, eval_episodes: int, spli
         }
     )
 
-    class Clock(NullReporter):
-        """The loop reports every 50 steps: time the span between reports, not the final save."""
-
-        marks: list[tuple[int, float]] = []
-
-        def update(self, snapshot):
-            if device != "cpu":
-                torch.cuda.synchronize()
-            self.marks.append((snapshot["step"], time.perf_counter()))
-
-    clock = Clock()
+    sync = torch.cuda.synchronize if device != "cpu" else (lambda: None)
+    clock = Clock(sync)
     trainer = Trainer(cfg, tempfile.mkdtemp(prefix="bipedal-bench-"), clock)
     trainer.run(total_steps=WARMUP + 100 + steps)
-    timed = [(s, t) for s, t in clock.marks if s >= WARMUP + 100]
-    (s0, t0), (s1, t1) = timed[0], timed[-2]  # the last mark comes after the final save
-    train_sps = (s1 - s0) / (t1 - t0)
+    train_sps = clock.steps_per_s(WARMUP + 100)
 
     # Gradient steps alone, on batches sampled beforehand.
     rng = np.random.default_rng(0)
