@@ -46,10 +46,26 @@ class Clock(NullReporter):
         return (s1 - s0) / (t1 - t0)
 
 
+def updates_per_s(trainer, batch: int, count: int, sync: Callable[[], None]) -> float:
+    """Gradient updates per second alone, on ``count`` batches drawn from the run's buffer
+    beforehand (generator seeded 0)."""
+    import numpy as np
+
+    rng = np.random.default_rng(0)
+    agent = trainer.agent
+    batches = [agent.batch_to_tensors(trainer.buffer.sample(batch, rng)) for _ in range(count)]
+    sync()
+    start = time.perf_counter()
+    for b in batches:
+        agent.update(b)
+    agent.sync()  # the last critics' step may still run on the worker thread
+    sync()
+    return count / (time.perf_counter() - start)
+
+
 def measure(
     config: str, device: str, batch: int, updates: int, steps: int, warmup: int, threads: int
 ) -> dict:
-    import numpy as np
     import torch
 
     from bipedal_cli.config import resolve_config
@@ -74,18 +90,9 @@ def measure(
     trainer.run(total_steps=warmup + 100 + steps)
     train_sps = clock.steps_per_s(warmup + 100)
 
-    rng = np.random.default_rng(0)
-    agent = trainer.agent
-    batches = [agent.batch_to_tensors(trainer.buffer.sample(batch, rng)) for _ in range(steps)]
-    sync()
-    start = time.perf_counter()
-    for b in batches:
-        agent.update(b)
-    agent.sync()
-    sync()
     return {
         "policy_steps_per_s": train_sps,
-        "updates_per_s": len(batches) / (time.perf_counter() - start),
+        "updates_per_s": updates_per_s(trainer, batch, steps, sync),
     }
 
 

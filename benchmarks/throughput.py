@@ -30,7 +30,7 @@ import time
 WARMUP = 1000
 
 
-from device_speed import Clock  # noqa: E402
+from device_speed import Clock, updates_per_s  # noqa: E402
 from record import cpu_name  # noqa: E402
 
 
@@ -39,7 +39,6 @@ def peak_rss_mb() -> float:
 
 
 def measure_ours(threads: int, steps: int, device: str, eval_episodes: int, split: bool) -> dict:
-    import numpy as np
     import torch
 
     from bipedal_cli.config import config_from_dict
@@ -66,16 +65,7 @@ def measure_ours(threads: int, steps: int, device: str, eval_episodes: int, spli
     trainer.run(total_steps=WARMUP + 100 + steps)
     train_sps = clock.steps_per_s(WARMUP + 100)
 
-    # Gradient steps alone, on batches sampled beforehand.
-    rng = np.random.default_rng(0)
-    batches = [trainer.agent.batch_to_tensors(trainer.buffer.sample(64, rng)) for _ in range(steps)]
-    start = time.perf_counter()
-    for b in batches:
-        trainer.agent.update(b)
-    trainer.agent.sync()  # the last critics' step may still run on the worker thread
-    if device != "cpu":
-        torch.cuda.synchronize()
-    update_sps = len(batches) / (time.perf_counter() - start)
+    update_sps = updates_per_s(trainer, 64, steps, sync)  # on batches drawn beforehand
 
     result = {"env_steps_per_s": train_sps, "updates_per_s": update_sps}
     if eval_episodes:
