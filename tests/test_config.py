@@ -43,6 +43,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-g99-probes": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-g99-probes-late": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-g99-utd2": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-wide": HARDCORE_H4,
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
     "hardcore-warm-kl100": HARDCORE_H4,
@@ -159,6 +160,19 @@ def test_hardcore_lrdecay_cvar25_g99_is_its_seed_0_run_but_for_the_discount():
     assert (g99.seed, g99.agent.gamma, cvar.agent.gamma) == (0, 0.99, 0.98)
     g99.seed, g99.agent.gamma = 1, 0.98
     assert g99 == cvar
+
+
+def test_hardcore_lrdecay_cvar25_wide_is_its_seed_0_run_but_for_the_critics_width():
+    """Session 27's run from scratch: hardcore-lrdecay-cvar25.yaml's seed-0 run with critics
+    of 512 units per hidden layer instead of 256; nothing else may differ."""
+    cvar, wide = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-lrdecay-cvar25", "hardcore-lrdecay-cvar25-wide")
+    )
+    assert (wide.seed, wide.agent.critic_hidden, cvar.agent.critic_hidden) == (0, 512, 256)
+    assert wide.agent.actor_hidden == 512
+    wide.seed, wide.agent.critic_hidden = 1, 256
+    assert wide == cvar
 
 
 RESTART_KEYS = tuple(

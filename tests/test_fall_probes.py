@@ -13,11 +13,9 @@ from bipedal_cli.config import config_from_dict
 from bipedal_cli.errors import UserError
 from bipedal_cli.fall_restarts import draws_probe, remembers_fall
 from bipedal_cli.metrics import read_metrics
-from bipedal_cli.resume import resume
 from bipedal_cli.train import Trainer, train
 
-from .test_fall_restarts import restart_dict
-from .test_train import assert_states_equal
+from .test_fall_restarts import assert_resumed_split_equals_straight, restart_dict
 
 
 def probe_dict(total_steps: int, **train_keys) -> dict:
@@ -90,15 +88,7 @@ def test_a_run_resumes_exactly_inside_a_probe(tmp_path):
     assert split not in ends
     train(config_from_dict(probe_dict(split)), tmp_path / "split")
     assert load_checkpoint(tmp_path / "split" / "state.pt")["episode"]["probe"] is True
-    second = resume(tmp_path / "split", total_steps=400)
-    assert straight.episodes == second.episodes
-    s, r = (load_checkpoint(tmp_path / n / "state.pt") for n in ("straight", "split"))
-    assert_states_equal(
-        {k: v for k, v in s.items() if k != "path"}, {k: v for k, v in r.items() if k != "path"}
-    )
-    timeless = [{k: v for k, v in row.items() if k != "wall_time"} for row in rows]
-    resumed = read_metrics(tmp_path / "split" / "metrics.csv")
-    assert [{k: v for k, v in row.items() if k != "wall_time"} for row in resumed] == timeless
+    assert_resumed_split_equals_straight(tmp_path, straight, rows)
 
 
 @pytest.mark.parametrize("value", [-0.1, 1.5])

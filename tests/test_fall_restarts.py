@@ -35,6 +35,20 @@ def restart_dict(total_steps: int, **train_keys) -> dict:
     return tiny_dict(total_steps=total_steps, **{**RESTARTS, **train_keys})
 
 
+def assert_resumed_split_equals_straight(tmp_path, straight, rows, total_steps=400):
+    """tmp_path/split, stopped mid-episode, resumed to total_steps: the same episodes, state and
+    metrics (but wall times) as tmp_path/straight, which ran there in one go."""
+    second = resume(tmp_path / "split", total_steps=total_steps)
+    assert straight.episodes == second.episodes
+    s, r = (load_checkpoint(tmp_path / n / "state.pt") for n in ("straight", "split"))
+    assert_states_equal(
+        {k: v for k, v in s.items() if k != "path"}, {k: v for k, v in r.items() if k != "path"}
+    )
+    timeless = [{k: v for k, v in row.items() if k != "wall_time"} for row in rows]
+    resumed = read_metrics(tmp_path / "split" / "metrics.csv")
+    assert [{k: v for k, v in row.items() if k != "wall_time"} for row in resumed] == timeless
+
+
 def test_the_draw_follows_the_probability_the_back_off_and_the_memory():
     t = config_from_dict(restart_dict(400, fall_restart=1.0, fall_restart_back=3)).train
     assert restarts_on(t, 51) and not restarts_on(t, 50)
@@ -147,15 +161,7 @@ def test_the_run_is_the_plain_run_before_its_start_and_resumes_exactly_inside_a_
     split = int(long_restart["step"]) - 2  # the restart is in progress there
     train(config_from_dict(restart_dict(split)), tmp_path / "split")
     assert load_checkpoint(tmp_path / "split" / "state.pt")["episode"]["restart_at"] is not None
-    second = resume(tmp_path / "split", total_steps=400)
-    assert straight.episodes == second.episodes
-    s, r = (load_checkpoint(tmp_path / n / "state.pt") for n in ("straight", "split"))
-    assert_states_equal(
-        {k: v for k, v in s.items() if k != "path"}, {k: v for k, v in r.items() if k != "path"}
-    )
-    timeless = [{k: v for k, v in row.items() if k != "wall_time"} for row in rows]
-    resumed = read_metrics(tmp_path / "split" / "metrics.csv")
-    assert [{k: v for k, v in row.items() if k != "wall_time"} for row in resumed] == timeless
+    assert_resumed_split_equals_straight(tmp_path, straight, rows)
 
 
 def test_a_branch_may_switch_restarts_on_at_its_step_but_not_before(tmp_path):
