@@ -11,9 +11,11 @@ K = 1 is the plain deterministic policy. The actor and critics come from one tra
 (`restart.pt` or `state.pt`), so they were trained together. On the gamma-0.99 run's state at
 1,944,373 it did not cut the falls (docs/hardcore.md, session 20).
 
-    python benchmarks/critic_guided.py \\
-        checkpoints/restarts/hardcore-lrdecay-cvar25-g99-seed0-rerun.pt --candidates 1 64 \\
+    git show a434a40:checkpoints/restarts/hardcore-lrdecay-cvar25-g99-seed0-rerun.pt > g99-rerun.pt
+    python benchmarks/critic_guided.py g99-rerun.pt --candidates 1 64 \\
         --seed 23000000 --episodes 600
+
+(That restart file left the tree in session 28; git keeps it.)
 
 Every K plays the same seeds, and the script prints each K's paired difference from the first.
 The draws of each batch of 10 seeds are seeded by its first seed, so a seed's result does not

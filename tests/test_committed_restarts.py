@@ -17,10 +17,10 @@ ROOT = Path(__file__).resolve().parent.parent
 RESTARTS = ROOT / "checkpoints" / "restarts"
 # restart file: (the config that trained it, its seed, the committed copy of its metrics)
 COMMITTED = {
-    "hardcore-lrdecay-cvar25-g99-seed0-rerun.pt": (
-        "hardcore-lrdecay-cvar25-g99.yaml",
-        0,
-        "docs/runs/hardcore-lrdecay-cvar25-g99-seed0-rerun/metrics.csv",
+    "hardcore-lrdecay-cvar25-seed2.pt": (
+        "hardcore-lrdecay-cvar25.yaml",
+        2,
+        "docs/runs/hardcore-lrdecay-cvar25-seed2/metrics.csv",
     ),
 }
 

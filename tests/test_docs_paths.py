@@ -1,6 +1,8 @@
 """Every file that README.md and docs/*.md name or show is in the repository: a figure's source
 (metrics.csv, eval JSON, benchmark output) that is not committed is not a source. Paths are
-checked against git's list of tracked and not-ignored files, as a fresh clone would have them."""
+checked against git's list of tracked and not-ignored files, as a fresh clone would have them. A
+file that left the tree is named as git names it in a commit, ``<commit>:path`` (as in ``git show
+<commit>:path > file``), and is checked in that commit."""
 
 import re
 import subprocess
@@ -11,7 +13,10 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 NAMED = re.compile(
-    r"(?<![\w/.])((?:docs|benchmarks|configs|checkpoints|bipedal_cli|tests)/[\w./-]*)"
+    r"(?<![\w/.:])((?:docs|benchmarks|configs|checkpoints|bipedal_cli|tests)/[\w./-]*)"
+)
+AT_COMMIT = re.compile(
+    r"\b([0-9a-f]{7,40}):((?:docs|benchmarks|configs|checkpoints|bipedal_cli|tests)/[\w./-]*)"
 )
 LINKED = re.compile(r"\]\(([^)#\s]+)\)")
 
@@ -43,6 +48,18 @@ def named_paths(doc: Path) -> set[str]:
     return {p for p in paths if not re.search(r"[<>*{}]", p)}
 
 
+def in_commit(commit: str, path: str) -> bool:
+    out = subprocess.run(
+        ["git", "cat-file", "-e", f"{commit}:{path}"], cwd=ROOT, capture_output=True
+    )
+    return out.returncode == 0
+
+
+def paths_at_commits(doc: Path) -> set[tuple[str, str]]:
+    """The ``<commit>:path`` names in a document: files that left the tree, kept in git."""
+    return {(m.group(1), m.group(2).rstrip(".,:;")) for m in AT_COMMIT.finditer(doc.read_text())}
+
+
 @pytest.mark.parametrize("doc", DOCS, ids=lambda d: d.name)
 def test_every_path_a_document_names_is_committed(doc):
     files = repository_files()
@@ -50,6 +67,8 @@ def test_every_path_a_document_names_is_committed(doc):
         p for p in named_paths(doc) if p not in files and p.rstrip("/") + "/" not in files
     )
     assert not missing, f"{doc.name} names files a fresh clone lacks: {missing}"
+    lost = sorted(f"{c}:{p}" for c, p in paths_at_commits(doc) if not in_commit(c, p))
+    assert not lost, f"{doc.name} names files those commits lack: {lost}"
 
 
 def test_the_checker_sees_a_missing_path(tmp_path):
@@ -57,3 +76,12 @@ def test_the_checker_sees_a_missing_path(tmp_path):
     assert "checkpoints/bipedal_hardcore.eval.json" in named_paths(ROOT / "README.md")
     assert "docs/images/hardcore_runs.png" in named_paths(doc)  # ](images/...) from docs/
     assert "docs/runs/nope/metrics.csv" not in repository_files()
+    # a file named at a commit is looked up in that commit, not in the tree
+    named = tmp_path / "named.md"
+    named.write_text(
+        "`git show 409ad4c:checkpoints/gone.pt > a.pt`, checkpoints/bipedal_hardcore.pt"
+    )
+    assert named_paths(named) == {"checkpoints/bipedal_hardcore.pt"}
+    assert paths_at_commits(named) == {("409ad4c", "checkpoints/gone.pt")}
+    assert in_commit("409ad4c", "checkpoints/bipedal_hardcore.pt")
+    assert not in_commit("409ad4c", "checkpoints/gone.pt")
