@@ -12,12 +12,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
-NAMED = re.compile(
-    r"(?<![\w/.:])((?:docs|benchmarks|configs|checkpoints|bipedal_cli|tests)/[\w./-]*)"
-)
-AT_COMMIT = re.compile(
-    r"\b([0-9a-f]{7,40}):((?:docs|benchmarks|configs|checkpoints|bipedal_cli|tests)/[\w./-]*)"
-)
+REPO_PATH = r"(?:docs|benchmarks|configs|checkpoints|bipedal_cli|tests)/[\w./-]*"
+NAMED = re.compile(rf"(?<![\w/.:])({REPO_PATH})")  # not after "<commit>:"
+AT_COMMIT = re.compile(rf"\b([0-9a-f]{{7,40}}):({REPO_PATH})")
 LINKED = re.compile(r"\]\(([^)#\s]+)\)")
 
 
