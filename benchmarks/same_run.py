@@ -27,6 +27,14 @@ def rows(run: Path) -> list[dict[str, str]]:
     return [{k: v for k, v in row.items() if k not in IGNORED} for row in read_metrics(path)]
 
 
+def differences(a: dict[str, str], b: dict[str, str]) -> dict[str, tuple[str, str]]:
+    """The columns where two rows differ; a column one file lacks (written by an older version,
+    before the column existed) counts as empty there."""
+    return {
+        k: (a.get(k, ""), b.get(k, "")) for k in a.keys() | b.keys() if a.get(k, "") != b.get(k, "")
+    }
+
+
 def main() -> int:
     if len(sys.argv) != 3:
         print(__doc__.strip().splitlines()[2].strip(), file=sys.stderr)
@@ -37,15 +45,12 @@ def main() -> int:
         return 2
     a, b = (rows(Path(p)) for p in sys.argv[1:])
     n = min(len(a), len(b))
-    same = next((i for i in range(n) if a[i] != b[i]), n)
+    same = next((i for i in range(n) if differences(a[i], b[i])), n)
     last = a[same - 1] if same else None
     where = f" (to step {int(last['step']):,}, episode {last['episode']})" if last else ""
     print(f"{same:,} of {n:,} rows agree{where}")
     if same < n:
-        diff = {
-            k: (a[same].get(k), b[same].get(k)) for k in a[same] if a[same][k] != b[same].get(k)
-        }
-        print(f"row {same + 1:,} differs: {diff}")
+        print(f"row {same + 1:,} differs: {differences(a[same], b[same])}")
         return 1
     return 0
 

@@ -1,0 +1,56 @@
+"""benchmarks/heldout_falls.py puts every run's held-out windows against the shipped policy's
+score on the same seeds, and refuses a report that played another policy under its path."""
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+sys.path.insert(0, str(BENCHMARKS))
+spec = importlib.util.spec_from_file_location("heldout_falls", BENCHMARKS / "heldout_falls.py")
+heldout_falls = importlib.util.module_from_spec(spec)
+sys.modules["heldout_falls"] = heldout_falls  # its dataclass looks its module up there
+spec.loader.exec_module(heldout_falls)
+
+SHA = "ab" * 32
+
+
+def candidate(path, step, mean, falls, sha256="00" * 32):
+    held = {"episodes": 200, "mean": mean, "falls": falls, "median": 300.0, "mean_length": 900}
+    return {"path": path, "step": step, "sha256": sha256, "held_out": held}
+
+
+def report():
+    return {
+        "candidates": [
+            candidate(heldout_falls.REFERENCE, 1_740_000, 290.0, 8, SHA),
+            candidate("runs/a/policies/step-1500000.pt", 1_500_000, 280.0, 20),
+            candidate("runs/a/policies/step-1520000.pt", 1_520_000, 284.0, 10),
+            candidate("runs/a/policies/step-1600000.pt", 1_600_000, 295.0, 4),
+            candidate("runs/a/policy.pt", 1_612_345, 291.0, 6),
+        ]
+    }
+
+
+def test_windows_are_differences_from_the_reference_on_the_same_seeds():
+    windows = heldout_falls.against_reference(report(), 100_000, SHA)
+    got = [(w.run, w.first_step, w.policies, w.extra_falls, w.extra_return) for w in windows]
+    # the reference falls 4 times per 100 (8 in 200) and scores 290.0
+    assert got == [
+        ("runs/a", 1_500_000, 2, pytest.approx(7.5 - 4.0), pytest.approx(282.0 - 290.0)),
+        ("runs/a", 1_600_000, 1, pytest.approx(2.0 - 4.0), pytest.approx(5.0)),
+        ("runs/a/policy.pt", 1_612_345, 1, pytest.approx(3.0 - 4.0), pytest.approx(1.0)),
+    ]
+    assert [w.single_file for w in windows] == [False, False, True]
+    label = heldout_falls.row_label(Path("x/hardcore-select-session13.json"), "runs/a/policy.pt")
+    assert label == "session13: a"
+
+
+def test_a_report_that_played_another_policy_under_the_shipped_path_is_refused():
+    with pytest.raises(ValueError, match="sha256"):
+        heldout_falls.against_reference(report(), 100_000, "cd" * 32)
+    without = {"candidates": report()["candidates"][1:]}
+    with pytest.raises(ValueError, match="does not play"):
+        heldout_falls.against_reference(without, 100_000, SHA)
