@@ -68,7 +68,7 @@ def row_label(report: Path, run: str) -> str:
     return f"{report.stem.split('-')[-1]}: {name}"
 
 
-def draw(rows: dict[str, list[Window]], out: Path) -> None:
+def draw(rows: dict[str, list[Window]], every: int, out: Path) -> None:
     """One row per run and report, top to bottom in the reports' order; a dot per window of
     kept policies, a ring for a policy file named on its own."""
     import matplotlib
@@ -93,7 +93,7 @@ def draw(rows: dict[str, list[Window]], out: Path) -> None:
         ax.grid(axis="x", alpha=0.3)
     axes[0].set_yticks(range(len(labels)), labels[::-1], fontsize=8)
     fig.suptitle(
-        "Held-out seeds: each run's kept policies by 100,000-step window (dots), "
+        f"Held-out seeds: each run's kept policies by {every:,}-step window (dots), "
         "a policy file on its own (ring)",
         fontsize=10,
     )
@@ -123,7 +123,7 @@ def main() -> None:
             )
             rows.setdefault(row_label(report, w.run), []).append(w)
     if args.out:
-        draw(rows, args.out)
+        draw(rows, args.every, args.out)
         print(f"wrote {args.out}", file=sys.stderr)
 
 

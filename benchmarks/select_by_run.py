@@ -1,6 +1,7 @@
-"""Summarise a `bipedal select --json` report by run: over each run's candidates (all played the
-same held-out seeds), the mean held-out return, the falls per 100 episodes, the median return and
-the mean episode length, optionally in windows of policy steps (docs/hardcore.md, session 6).
+"""Summarise `bipedal select --json` reports by run: over each run's candidates (all played the
+same held-out seeds), the mean held-out return, the falls per 100 episodes, where they fell (all
+the group's falls, by obstacle), the median return and the mean episode length, optionally in
+windows of policy steps (docs/hardcore.md, session 6). One table per report.
 
     python benchmarks/select_by_run.py docs/runs/hardcore-select-session6.json --every 100000
 
@@ -12,7 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
-from collections import defaultdict
+from collections import Counter, defaultdict
 from pathlib import Path
 from statistics import mean
 
@@ -22,12 +23,17 @@ def run_of(path: str) -> str:
     return str(p.parent.parent) if p.parent.name == "policies" else str(p)
 
 
+def group_of(candidate: dict, every: int) -> tuple[str, int]:
+    """(run, first step of its window of `every` policy steps; 0 for no windows)."""
+    window = candidate["step"] // every * every if every else 0
+    return run_of(candidate["path"]), window
+
+
 def summarise(candidates: list[dict], every: int) -> list[tuple]:
     """(run, first step, last step, policies, mean return, falls per 100, median, length)."""
     groups: dict[tuple[str, int], list[dict]] = defaultdict(list)
     for c in candidates:
-        window = c["step"] // every * every if every else 0
-        groups[(run_of(c["path"]), window)].append(c)
+        groups[group_of(c, every)].append(c)
     rows = []
     for (run, _), group in sorted(groups.items()):
         held = [c["held_out"] for c in group]
@@ -46,21 +52,40 @@ def summarise(candidates: list[dict], every: int) -> list[tuple]:
     return rows
 
 
+def falls_where(candidates: list[dict], every: int) -> dict[tuple[str, int], Counter]:
+    """All falls of each (run, window)'s candidates by obstacle, as `select` records them."""
+    where: dict[tuple[str, int], Counter] = defaultdict(Counter)
+    for c in candidates:
+        where[group_of(c, every)].update(c["held_out"].get("falls_at") or {})
+    return where
+
+
+def print_report(path: Path, every: int) -> None:
+    report = json.loads(path.read_text())
+    first, last = report["seeds"]
+    print(f"{path}: held-out seeds {first:,}-{last:,}")
+    print(
+        "| run | policy steps | policies | mean return | falls per 100 | where they fell "
+        "| median | mean length |\n|---|---|---|---|---|---|---|---|"
+    )
+    where = falls_where(report["candidates"], every)
+    for run, lo, hi, n, ret, falls, median, length in summarise(report["candidates"], every):
+        steps = f"{lo:,}" if lo == hi else f"{lo:,}-{hi:,}"
+        counts = where[group_of({"path": run, "step": lo}, every)]
+        at = ", ".join(f"{k} {v}" for k, v in counts.most_common()) or "-"
+        print(
+            f"| {run} | {steps} | {n} | {ret:.1f} | {falls:.1f} | {at} | {median:.1f} "
+            f"| {length:.0f} |"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("report", type=Path, help="a `bipedal select --json` file")
+    parser.add_argument("reports", type=Path, nargs="+", help="`bipedal select --json` files")
     parser.add_argument("--every", type=int, default=0, help="window of policy steps (0: none)")
     args = parser.parse_args()
-    report = json.loads(args.report.read_text())
-    first, last = report["seeds"]
-    print(f"{args.report}: held-out seeds {first:,}-{last:,}")
-    print(
-        "| run | policy steps | policies | mean return | falls per 100 | median | mean length |\n"
-        "|---|---|---|---|---|---|---|"
-    )
-    for run, lo, hi, n, ret, falls, median, length in summarise(report["candidates"], args.every):
-        steps = f"{lo:,}" if lo == hi else f"{lo:,}-{hi:,}"
-        print(f"| {run} | {steps} | {n} | {ret:.1f} | {falls:.1f} | {median:.1f} | {length:.0f} |")
+    for path in args.reports:
+        print_report(path, args.every)
 
 
 if __name__ == "__main__":

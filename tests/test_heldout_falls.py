@@ -54,3 +54,14 @@ def test_a_report_that_played_another_policy_under_the_shipped_path_is_refused()
     without = {"candidates": report()["candidates"][1:]}
     with pytest.raises(ValueError, match="does not play"):
         heldout_falls.against_reference(without, 100_000, SHA)
+
+
+def test_select_by_run_counts_where_each_window_fell():
+    import select_by_run
+
+    candidates = report()["candidates"]
+    candidates[1]["held_out"]["falls_at"] = {"stump": 15, "pit": 5}
+    candidates[2]["held_out"]["falls_at"] = {"stump": 6, "stairs": 4}
+    where = select_by_run.falls_where(candidates, 100_000)
+    assert where[("runs/a", 1_500_000)] == {"stump": 21, "pit": 5, "stairs": 4}
+    assert where[("runs/a/policy.pt", 1_600_000)] == {}  # no falls_at recorded
