@@ -34,10 +34,23 @@ def check_output_path(
         raise UserError(f"{option} {path}: is a directory; expected a file path")
     if not parent.is_dir():
         raise UserError(f"{option} {path}: directory {parent} does not exist")
-    if not os.access(parent, os.W_OK):
+    if not _can_create_in(parent):
         raise UserError(f"{option} {path}: directory {parent} is not writable")
     if path.exists() and not force:
         raise UserError(f"{option} {path}: already exists; pass --force to overwrite it")
+
+
+def _can_create_in(directory: Path) -> bool:
+    """Whether a file can be created in ``directory``, found by creating (and removing) one.
+
+    ``os.access`` answers from the permission bits, which root passes even where the file system
+    refuses files (``/proc``, a read-only mount), so the output would fail only after the work.
+    """
+    try:
+        with tempfile.TemporaryFile(dir=directory):
+            return True
+    except OSError:
+        return False
 
 
 @contextmanager

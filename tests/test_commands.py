@@ -1,6 +1,7 @@
 """record, plot, export, info and curriculum, end to end through the CLI."""
 
 import csv
+import os
 
 import imageio.v2 as imageio
 import numpy as np
@@ -155,6 +156,8 @@ def test_output_errors(tmp_path, trained, capsys):
         (["plot", tmp_path / "nowhere", "--out", tmp_path / "c2.png"], "nowhere"),
         (["plot", trained, "--metric", "wings", "--out", tmp_path / "c3.png"], "--metric"),
     ]
+    if os.path.isdir("/proc"):  # refuses new files even to root, whose permission bits all pass
+        cases.append((["record", trained, "--out", "/proc/a.mp4"], "/proc is not writable"))
     for args, needle in cases:
         code, _, err = run_cli(args, capsys)
         assert code == 2 and len(err.strip().splitlines()) == 1 and needle in err, (args, err)
