@@ -1,3 +1,8 @@
+import importlib
+import sys
+from pathlib import Path
+from types import ModuleType
+
 import pytest
 
 from bipedal_cli.config import Config, config_from_dict
@@ -42,3 +47,15 @@ def tiny_config() -> Config:
 def wide_console(monkeypatch):
     """Rich tables fit the terminal width; keep captured output from being truncated."""
     monkeypatch.setenv("COLUMNS", "200")
+
+
+BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
+
+
+def load_benchmark(name: str) -> ModuleType:
+    """Import ``benchmarks/<name>.py``. The folder is not a package: its scripts run as
+    ``python benchmarks/<name>.py`` and import each other by name, so it goes first on the path,
+    as it does for a script run that way."""
+    if str(BENCHMARKS) not in sys.path:
+        sys.path.insert(0, str(BENCHMARKS))
+    return importlib.import_module(name)

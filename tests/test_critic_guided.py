@@ -1,19 +1,16 @@
 """benchmarks/critic_guided.py scores candidate actions by the mean of their L lowest pooled
 atoms; L is the actor's own count for the CVaR fraction (schedule.actor_lowest_atoms)."""
 
-import importlib.util
 import math
-from pathlib import Path
 from types import SimpleNamespace
 
 import torch
 
 from bipedal_cli.schedule import actor_lowest_atoms
 
-SCRIPT = Path(__file__).resolve().parent.parent / "benchmarks" / "critic_guided.py"
-spec = importlib.util.spec_from_file_location("critic_guided", SCRIPT)
-critic_guided = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(critic_guided)
+from .conftest import load_benchmark
+
+critic_guided = load_benchmark("critic_guided")
 
 
 def reference_lowest_mean(atoms, fraction):

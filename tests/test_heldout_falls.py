@@ -1,18 +1,13 @@
 """benchmarks/heldout_falls.py puts every run's held-out windows against the shipped policy's
 score on the same seeds, and refuses a report that played another policy under its path."""
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import pytest
 
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
-sys.path.insert(0, str(BENCHMARKS))
-spec = importlib.util.spec_from_file_location("heldout_falls", BENCHMARKS / "heldout_falls.py")
-heldout_falls = importlib.util.module_from_spec(spec)
-sys.modules["heldout_falls"] = heldout_falls  # its dataclass looks its module up there
-spec.loader.exec_module(heldout_falls)
+from .conftest import load_benchmark
+
+heldout_falls = load_benchmark("heldout_falls")
 
 SHA = "ab" * 32
 
@@ -57,8 +52,7 @@ def test_a_report_that_played_another_policy_under_the_shipped_path_is_refused()
 
 
 def test_select_by_run_counts_where_each_window_fell():
-    import select_by_run
-
+    select_by_run = load_benchmark("select_by_run")
     candidates = report()["candidates"]
     candidates[1]["held_out"]["falls_at"] = {"stump": 15, "pit": 5}
     candidates[2]["held_out"]["falls_at"] = {"stump": 6, "stairs": 4}

@@ -2,17 +2,15 @@
 benchmarks/pool_heldout.py pools held-out blocks from their summaries into what the episodes
 themselves give, and counts a seed block once per policy."""
 
-import importlib.util
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-SCRIPT = Path(__file__).resolve().parent.parent / "benchmarks" / "pool_heldout.py"
-spec = importlib.util.spec_from_file_location("pool_heldout", SCRIPT)
-pool_heldout = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(pool_heldout)
+from .conftest import load_benchmark
+
+pool_heldout = load_benchmark("pool_heldout")
 
 
 def test_pooled_summaries_equal_the_statistics_of_all_episodes():

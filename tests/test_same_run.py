@@ -2,13 +2,9 @@
 predates (``restart_from``) counts as empty, so a retrained run can be checked against a run
 committed before the column existed, and a real difference is still reported."""
 
-import importlib.util
-from pathlib import Path
+from .conftest import load_benchmark
 
-SCRIPT = Path(__file__).resolve().parent.parent / "benchmarks" / "same_run.py"
-spec = importlib.util.spec_from_file_location("same_run", SCRIPT)
-same_run = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(same_run)
+same_run = load_benchmark("same_run")
 
 
 def test_a_column_one_file_lacks_counts_as_empty():
