@@ -52,12 +52,18 @@ def against_reference(report: dict, every: int, sha256: str, reference: str = RE
     if len(matches) != 1 or matches[0].get("sha256") != sha256:
         raise ValueError(f"the report does not play {reference} with sha256 {sha256[:12]}...")
     rows = summarise(report["candidates"], every)
-    (bar,) = [row for row in rows if row[0] == reference]
-    bar_return, bar_falls = bar[4], bar[5]
+    (bar,) = [row for row in rows if row.run == reference]
     return [
-        Window(run, lo, n, falls, falls - bar_falls, ret - bar_return)
-        for run, lo, _, n, ret, falls, _, _ in rows
-        if run != reference
+        Window(
+            row.run,
+            row.first_step,
+            row.policies,
+            row.falls_per_100,
+            row.falls_per_100 - bar.falls_per_100,
+            row.mean_return - bar.mean_return,
+        )
+        for row in rows
+        if row.run != reference
     ]
 
 

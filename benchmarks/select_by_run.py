@@ -16,6 +16,7 @@ import json
 from collections import Counter, defaultdict
 from pathlib import Path
 from statistics import mean
+from typing import NamedTuple
 
 
 def run_of(path: str) -> str:
@@ -29,35 +30,45 @@ def group_of(candidate: dict, every: int) -> tuple[str, int]:
     return run_of(candidate["path"]), window
 
 
-def summarise(candidates: list[dict], every: int) -> list[tuple]:
-    """(run, first step, last step, policies, mean return, falls per 100, median, length)."""
+class Window(NamedTuple):
+    """One run's candidates in one window of policy steps, summarised."""
+
+    run: str
+    first_step: int
+    last_step: int
+    policies: int
+    mean_return: float
+    falls_per_100: float
+    falls_at: Counter  # all the window's falls, by obstacle, as `select` records them
+    median: float
+    mean_length: float
+
+
+def summarise(candidates: list[dict], every: int) -> list[Window]:
+    """One Window per (run, window of `every` policy steps), in run then step order."""
     groups: dict[tuple[str, int], list[dict]] = defaultdict(list)
     for c in candidates:
         groups[group_of(c, every)].append(c)
     rows = []
     for (run, _), group in sorted(groups.items()):
         held = [c["held_out"] for c in group]
+        falls_at: Counter = Counter()
+        for h in held:
+            falls_at.update(h.get("falls_at") or {})
         rows.append(
-            (
-                run,
-                min(c["step"] for c in group),
-                max(c["step"] for c in group),
-                len(group),
-                mean(h["mean"] for h in held),
-                mean(100 * h["falls"] / h["episodes"] for h in held),
-                mean(h["median"] for h in held),
-                mean(h["mean_length"] for h in held),
+            Window(
+                run=run,
+                first_step=min(c["step"] for c in group),
+                last_step=max(c["step"] for c in group),
+                policies=len(group),
+                mean_return=mean(h["mean"] for h in held),
+                falls_per_100=mean(100 * h["falls"] / h["episodes"] for h in held),
+                falls_at=falls_at,
+                median=mean(h["median"] for h in held),
+                mean_length=mean(h["mean_length"] for h in held),
             )
         )
     return rows
-
-
-def falls_where(candidates: list[dict], every: int) -> dict[tuple[str, int], Counter]:
-    """All falls of each (run, window)'s candidates by obstacle, as `select` records them."""
-    where: dict[tuple[str, int], Counter] = defaultdict(Counter)
-    for c in candidates:
-        where[group_of(c, every)].update(c["held_out"].get("falls_at") or {})
-    return where
 
 
 def print_report(path: Path, every: int) -> None:
@@ -68,14 +79,16 @@ def print_report(path: Path, every: int) -> None:
         "| run | policy steps | policies | mean return | falls per 100 | where they fell "
         "| median | mean length |\n|---|---|---|---|---|---|---|---|"
     )
-    where = falls_where(report["candidates"], every)
-    for run, lo, hi, n, ret, falls, median, length in summarise(report["candidates"], every):
-        steps = f"{lo:,}" if lo == hi else f"{lo:,}-{hi:,}"
-        counts = where[group_of({"path": run, "step": lo}, every)]
-        at = ", ".join(f"{k} {v}" for k, v in counts.most_common()) or "-"
+    for w in summarise(report["candidates"], every):
+        steps = (
+            f"{w.first_step:,}"
+            if w.first_step == w.last_step
+            else (f"{w.first_step:,}-{w.last_step:,}")
+        )
+        at = ", ".join(f"{k} {v}" for k, v in w.falls_at.most_common()) or "-"
         print(
-            f"| {run} | {steps} | {n} | {ret:.1f} | {falls:.1f} | {at} | {median:.1f} "
-            f"| {length:.0f} |"
+            f"| {w.run} | {steps} | {w.policies} | {w.mean_return:.1f} | {w.falls_per_100:.1f} "
+            f"| {at} | {w.median:.1f} | {w.mean_length:.0f} |"
         )
 
 

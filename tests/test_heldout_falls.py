@@ -56,6 +56,13 @@ def test_select_by_run_counts_where_each_window_fell():
     candidates = report()["candidates"]
     candidates[1]["held_out"]["falls_at"] = {"stump": 15, "pit": 5}
     candidates[2]["held_out"]["falls_at"] = {"stump": 6, "stairs": 4}
-    where = select_by_run.falls_where(candidates, 100_000)
-    assert where[("runs/a", 1_500_000)] == {"stump": 21, "pit": 5, "stairs": 4}
-    assert where[("runs/a/policy.pt", 1_600_000)] == {}  # no falls_at recorded
+    windows = select_by_run.summarise(candidates, 100_000)
+    got = [(w.run, w.first_step, w.last_step, w.policies, w.falls_at) for w in windows]
+    assert got == [
+        (heldout_falls.REFERENCE, 1_740_000, 1_740_000, 1, {}),  # a file on its own is its run
+        ("runs/a", 1_500_000, 1_520_000, 2, {"stump": 21, "pit": 5, "stairs": 4}),
+        ("runs/a", 1_600_000, 1_600_000, 1, {}),  # no falls_at recorded
+        ("runs/a/policy.pt", 1_612_345, 1_612_345, 1, {}),
+    ]
+    assert windows[1].falls_per_100 == pytest.approx((10.0 + 5.0) / 2)
+    assert windows[1].mean_return == pytest.approx(282.0)
