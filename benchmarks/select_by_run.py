@@ -30,7 +30,7 @@ def group_of(candidate: dict, every: int) -> tuple[str, int]:
     return run_of(candidate["path"]), window
 
 
-class Window(NamedTuple):
+class WindowSummary(NamedTuple):
     """One run's candidates in one window of policy steps, summarised."""
 
     run: str
@@ -44,8 +44,8 @@ class Window(NamedTuple):
     mean_length: float
 
 
-def summarise(candidates: list[dict], every: int) -> list[Window]:
-    """One Window per (run, window of `every` policy steps), in run then step order."""
+def summarise(candidates: list[dict], every: int) -> list[WindowSummary]:
+    """One WindowSummary per (run, window of `every` policy steps), in run then step order."""
     groups: dict[tuple[str, int], list[dict]] = defaultdict(list)
     for c in candidates:
         groups[group_of(c, every)].append(c)
@@ -56,7 +56,7 @@ def summarise(candidates: list[dict], every: int) -> list[Window]:
         for h in held:
             falls_at.update(h.get("falls_at") or {})
         rows.append(
-            Window(
+            WindowSummary(
                 run=run,
                 first_step=min(c["step"] for c in group),
                 last_step=max(c["step"] for c in group),
@@ -80,11 +80,9 @@ def print_report(path: Path, every: int) -> None:
         "| median | mean length |\n|---|---|---|---|---|---|---|---|"
     )
     for w in summarise(report["candidates"], every):
-        steps = (
-            f"{w.first_step:,}"
-            if w.first_step == w.last_step
-            else (f"{w.first_step:,}-{w.last_step:,}")
-        )
+        steps = f"{w.first_step:,}"
+        if w.last_step != w.first_step:
+            steps += f"-{w.last_step:,}"
         at = ", ".join(f"{k} {v}" for k, v in w.falls_at.most_common()) or "-"
         print(
             f"| {w.run} | {steps} | {w.policies} | {w.mean_return:.1f} | {w.falls_per_100:.1f} "
