@@ -1,0 +1,93 @@
+"""Do two checkpoints hold the same policy? Compare their actors tensor for tensor (issue 14's
+item 2: the shipped policy, retrained from scratch by its committed command).
+
+    python benchmarks/same_policy.py checkpoints/bipedal_hardcore.pt RUN/policies/step-1740000.pt
+
+Either file may be a policy file or a training state. It prints how many actor tensors are
+equal (``torch.equal``: same shape, same bits), the largest absolute difference, and the
+counters both files record (env, policy steps, env steps, episodes, last evaluation); the exit
+status is 1 when a tensor or a counter differs, 2 on bad input.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import torch
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from bipedal_cli.checkpoint import POLICY_FORMAT, load_checkpoint  # noqa: E402
+from bipedal_cli.errors import UserError  # noqa: E402
+
+COUNTERS = ("env", "steps", "env_steps", "episodes")
+
+
+def actor_of(data: dict) -> dict[str, torch.Tensor]:
+    """The actor's tensors, from a policy file or a training state."""
+    return data["actor"] if data["format"] == POLICY_FORMAT else data["agent"]["actor"]
+
+
+def counters_of(data: dict) -> dict[str, object]:
+    """What the file records about where the policy was taken: env, policy steps, env steps,
+    episodes and the last periodic evaluation's mean."""
+    if data["format"] == POLICY_FORMAT:
+        meta = data["meta"]
+        found = {k: meta.get(k) for k in COUNTERS}
+        last = meta.get("last_eval")
+    else:
+        c = data["counters"]
+        found = {
+            "env": data["config"]["env"],
+            "steps": c["step"],
+            "env_steps": c["env_steps"],
+            "episodes": c["episodes"],
+        }
+        last = data.get("last_eval")
+    found["last_eval"] = round(float(last["mean"]), 3) if last else None
+    return found
+
+
+def compare_actors(
+    a: dict[str, torch.Tensor], b: dict[str, torch.Tensor]
+) -> tuple[list[str], float]:
+    """The names of the tensors that differ (or exist in one actor only) and the largest
+    absolute difference between tensors of the same name and shape."""
+    differing = sorted(a.keys() ^ b.keys())
+    largest = 0.0
+    for name in sorted(a.keys() & b.keys()):
+        x, y = a[name], b[name]
+        if x.shape != y.shape:
+            differing.append(name)
+            continue
+        if not torch.equal(x, y):
+            differing.append(name)
+        largest = max(largest, (x.double() - y.double()).abs().max().item())
+    return differing, largest
+
+
+def main(argv: list[str]) -> int:
+    if len(argv) != 2:
+        print(__doc__.strip().splitlines()[3].strip(), file=sys.stderr)
+        return 2
+    try:
+        first, second = (load_checkpoint(p, f"file {i + 1}") for i, p in enumerate(argv))
+    except UserError as err:
+        print(err, file=sys.stderr)
+        return 2
+    a, b = actor_of(first), actor_of(second)
+    differing, largest = compare_actors(a, b)
+    n = len(a.keys() | b.keys())
+    print(f"{n - len(differing)} of {n} actor tensors equal; largest difference {largest:.3g}")
+    if differing:
+        print(f"differ: {', '.join(differing)}")
+    ca, cb = counters_of(first), counters_of(second)
+    for key in ca:
+        mark = "same" if ca[key] == cb[key] else "DIFFERENT"
+        print(f"{key:<10} {ca[key]!s:<28} {cb[key]!s:<28} {mark}")
+    return 1 if differing or ca != cb else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
