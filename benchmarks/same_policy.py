@@ -18,35 +18,27 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bipedal_cli.checkpoint import POLICY_FORMAT, load_checkpoint  # noqa: E402
+from bipedal_cli.checkpoint import (  # noqa: E402
+    POLICY_FORMAT,
+    actor_weights,
+    load_checkpoint,
+    training_progress,
+)
 from bipedal_cli.errors import UserError  # noqa: E402
 
-COUNTERS = ("env", "steps", "env_steps", "episodes")
-
-
-def actor_of(data: dict) -> dict[str, torch.Tensor]:
-    """The actor's tensors, from a policy file or a training state."""
-    return data["actor"] if data["format"] == POLICY_FORMAT else data["agent"]["actor"]
+COUNTERS = ("steps", "env_steps", "episodes")
 
 
 def counters_of(data: dict) -> dict[str, object]:
     """What the file records about where the policy was taken: env, policy steps, env steps,
     episodes and the last periodic evaluation's mean."""
-    if data["format"] == POLICY_FORMAT:
-        meta = data["meta"]
-        found = {k: meta.get(k) for k in COUNTERS}
-        last = meta.get("last_eval")
-    else:
-        c = data["counters"]
-        found = {
-            "env": data["config"]["env"],
-            "steps": c["step"],
-            "env_steps": c["env_steps"],
-            "episodes": c["episodes"],
-        }
-        last = data.get("last_eval")
-    found["last_eval"] = round(float(last["mean"]), 3) if last else None
-    return found
+    meta = data["meta"] if data["format"] == POLICY_FORMAT else training_progress(data)
+    last = meta.get("last_eval")
+    return {
+        "env": data["config"]["env"],
+        **{k: meta.get(k) for k in COUNTERS},
+        "last_eval": round(float(last["mean"]), 3) if last else None,
+    }
 
 
 def compare_actors(
@@ -76,7 +68,7 @@ def main(argv: list[str]) -> int:
     except UserError as err:
         print(err, file=sys.stderr)
         return 2
-    a, b = actor_of(first), actor_of(second)
+    a, b = actor_weights(first), actor_weights(second)
     differing, largest = compare_actors(a, b)
     n = len(a.keys() | b.keys())
     print(f"{n - len(differing)} of {n} actor tensors equal; largest difference {largest:.3g}")

@@ -126,16 +126,34 @@ def policy_payload(
     }
 
 
+def actor_weights(data: dict[str, Any]) -> dict[str, torch.Tensor]:
+    """The actor's tensors of a checked policy file or training state."""
+    return data["actor"] if data["format"] == POLICY_FORMAT else data["agent"]["actor"]
+
+
+def training_progress(data: dict[str, Any]) -> dict[str, Any]:
+    """Where a checked training state stands, under a policy file's ``meta`` names: policy
+    steps, env steps, episodes, wall time and its last and full evaluations."""
+    c = data["counters"]
+    return {
+        "steps": c["step"],
+        "env_steps": c.get("env_steps", c["step"]),
+        "episodes": c["episodes"],
+        "wall_time": round(c["wall_time"], 1),
+        "last_eval": data["last_eval"],
+        "full_eval": data["full_eval"],
+    }
+
+
 def actor_from_checkpoint(data: dict[str, Any], option: str = "CKPT"):
     """Build the deterministic actor a policy or training-state checkpoint holds (on CPU)."""
     from .agent import make_actor
     from .config import config_from_dict
 
     cfg = config_from_dict(data["config"], f"{option} {data.get('path', '')}: config".strip())
-    actor_state = data["actor"] if data["format"] == POLICY_FORMAT else data["agent"]["actor"]
     actor = make_actor(cfg.agent, int(data["obs_dim"]), int(data["act_dim"]))
     try:
-        actor.load_state_dict(actor_state)
+        actor.load_state_dict(actor_weights(data))
     except RuntimeError:
         raise UserError(
             f"{option} {data.get('path')}: actor weights do not match its own config"
@@ -186,7 +204,7 @@ def initial_actor_state(cfg: Any, obs_dim: int, act_dim: int) -> dict[str, torch
                 f"{getattr(cfg.agent, key)!r}; expected a policy of the same shape and inputs"
             )
     check_dims(data, obs_dim, act_dim, cfg.env, option)
-    return data["actor"] if data["format"] == POLICY_FORMAT else data["agent"]["actor"]
+    return actor_weights(data)
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:

@@ -24,19 +24,13 @@ def _brief(value: Any) -> str:
 
 def checkpoint_table(data: dict, title: str) -> Table:
     """``bipedal info``: what a checkpoint (already checked by checkpoint.py) holds."""
-    from .checkpoint import TRAIN_FORMAT
+    from .checkpoint import TRAIN_FORMAT, training_progress
     from .config import config_from_dict
 
     cfg = config_from_dict(data["config"])
     if data["format"] == TRAIN_FORMAT:
-        c = data["counters"]
         meta = {
-            "steps": c["step"],
-            "env_steps": c.get("env_steps", c["step"]),
-            "episodes": c["episodes"],
-            "wall_time": round(c["wall_time"], 1),
-            "last_eval": data["last_eval"],
-            "full_eval": data["full_eval"],
+            **training_progress(data),
             "replay buffer": f"{int(data['buffer']['size']):,} transitions",
             "curriculum": data.get("curriculum"),
         }

@@ -54,8 +54,9 @@ def test_a_training_state_records_its_counters_under_other_names():
     state = {
         "format": TRAIN_FORMAT,
         "config": {"env": "BipedalWalkerHardcore-v3"},
-        "counters": {"step": 1740000, "env_steps": 5211833, "episodes": 8263},
+        "counters": {"step": 1740000, "env_steps": 5211833, "episodes": 8263, "wall_time": 9.0},
         "last_eval": {"mean": 308.32357},
+        "full_eval": None,
     }
     assert same_policy.counters_of(state) == {
         "env": "BipedalWalkerHardcore-v3",
