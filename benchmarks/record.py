@@ -22,19 +22,10 @@ from pathlib import Path
 RESULTS = Path(__file__).resolve().parent / "results"
 
 
-def cpu_name() -> str:
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
-
-
 def machine() -> dict:
     import torch
+
+    from bipedal_cli.devices import cpu_name
 
     return {
         "cpu": cpu_name(),
@@ -61,6 +52,17 @@ class _Tee(io.TextIOBase):
         self.stream.flush()
 
 
+def unused_path(folder: Path, stem: str) -> Path:
+    """``folder/stem.json``, or ``stem-2.json``, ``stem-3.json``... when taken: two records in
+    the same minute (two configs measured one after the other) must not overwrite each other."""
+    folder.mkdir(exist_ok=True)
+    out, n = folder / f"{stem}.json", 1
+    while out.exists():
+        n += 1
+        out = folder / f"{stem}-{n}.json"
+    return out
+
+
 def run_recorded(name: str, main: Callable[[], None]) -> Path:
     """Run ``main`` with its output shown and kept; write the JSON record; return its path."""
     started = time.strftime("%Y-%m-%d %H:%M:%S %Z")
@@ -70,8 +72,7 @@ def run_recorded(name: str, main: Callable[[], None]) -> Path:
         main()
     finally:
         sys.stdout = tee.stream
-    RESULTS.mkdir(exist_ok=True)
-    out = RESULTS / f"{name}-{time.strftime('%Y-%m-%d-%H%M')}.json"
+    out = unused_path(RESULTS, f"{name}-{time.strftime('%Y-%m-%d-%H%M')}")
     record = {
         "script": f"benchmarks/{name}.py",
         "argv": sys.argv[1:],

@@ -78,7 +78,19 @@ def main(argv: list[str]) -> int:
     for key in ca:
         mark = "same" if ca[key] == cb[key] else "DIFFERENT"
         print(f"{key:<10} {ca[key]!s:<28} {cb[key]!s:<28} {mark}")
+    # where each was written (files since 2026-12-05): a hint, not a difference, because a
+    # policy is the same policy wherever it was trained, but its bits are only expected to
+    # match when both were trained on one kind of CPU
+    machines = [written_on(data) for data in (first, second)]
+    if all(machines) and machines[0] != machines[1]:
+        print(f"written on {machines[0]} and on {machines[1]}")
     return 1 if differing or ca != cb else 0
+
+
+def written_on(data: dict) -> str | None:
+    """The machine a file records (``bipedal_cli.devices.machine_summary``), if any."""
+    meta = data["meta"] if data["format"] == POLICY_FORMAT else data
+    return meta.get("machine")
 
 
 if __name__ == "__main__":

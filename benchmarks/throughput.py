@@ -31,7 +31,8 @@ WARMUP = 1000
 
 
 from device_speed import Clock, updates_per_s  # noqa: E402
-from record import cpu_name  # noqa: E402
+
+from bipedal_cli.devices import cpu_name  # noqa: E402
 
 
 def peak_rss_mb() -> float:

@@ -31,6 +31,9 @@ def eval_(
     workers: Annotated[int, typer.Option("--workers", help="Processes (0: every core).")] = 0,
 ) -> None:
     """Evaluate the deterministic policy tanh(mean) on fixed env seeds (solved: mean > 300)."""
+    import torch
+
+    from .devices import machine_summary
     from .display import eval_table, verdict
     from .episode_progress import episode_progress
     from .evaluation import evaluate_actor, summarize
@@ -49,6 +52,8 @@ def eval_(
     elapsed = time.perf_counter() - started
     summary = summarize(results, cfg.train.solved_threshold)
     summary.update({"env": env_id, "seeds": [seeds[0], seeds[-1]], "checkpoint": str(ckpt)})
+    # the policy runs on the CPU, whose rounding can flip a knife-edge episode (session 33)
+    summary["machine"] = machine_summary(torch.device("cpu"))
     console.print(eval_table(summary, f"{env_id}: {ckpt} (env seeds {seeds[0]}..{seeds[-1]})"))
     console.print(verdict(summary) + f"   [{elapsed:.1f} s]")
     if json_out is not None:

@@ -102,7 +102,12 @@ def select(
             shutil.copyfile(winner.path, tmp)
         console.print(f"copied to {printable(out)}; report its score with `bipedal eval {out}`")
     if json_out is not None:
+        import torch
+
+        from .devices import machine_summary
+
         payload.update(chosen=str(winner.path), candidates=_rows(chosen, scores))
+        payload["machine"] = machine_summary(torch.device("cpu"))  # the CPU's rounding counts
         with atomic_path(json_out) as tmp:
             tmp.write_text(json.dumps(payload, indent=1))
 

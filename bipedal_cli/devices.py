@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import platform
 
 import torch
 
@@ -31,3 +32,26 @@ def configure_threads(train: TrainConfig, device: torch.device) -> bool:
     # see TrainConfig.flush_denormal (measured: benchmarks/throughput.py)
     torch.set_flush_denormal(train.flush_denormal)
     return split
+
+
+def cpu_name() -> str:
+    """The CPU's model name (``/proc/cpuinfo`` on Linux), else what ``platform`` knows."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def machine_summary(device: torch.device) -> str:
+    """Where a run's maths happens, as policy files and training states record it: the CPU and
+    the widest vector instructions torch's kernels use on it (AVX2, AVX512...), and the GPU on
+    CUDA. A seed fixes a run's bits only on one such machine: matrix products on AVX512 round
+    differently from AVX2 (docs/hardcore.md, session 33)."""
+    cpu = f"{cpu_name()} ({torch.backends.cpu.get_cpu_capability()} kernels)"
+    if device.type == "cuda":
+        return f"{torch.cuda.get_device_name(device)}; {cpu}"
+    return cpu

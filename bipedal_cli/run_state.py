@@ -23,6 +23,7 @@ from .checkpoint import (
     atomic_save,
     policy_payload,
 )
+from .devices import machine_summary
 from .errors import UserError
 from .metrics import METRICS_FILE
 
@@ -70,6 +71,7 @@ def run_state(trainer: Any, replay: bool = True) -> dict[str, Any]:
         "last_eval": trainer.last_eval,
         "full_eval": trainer.full_eval,
         "curriculum": trainer.curriculum,
+        "machine": machine_summary(trainer.device),  # since 2026-12-05
         # so that an episode ending right after a resume still logs its losses
         "update_metrics": (
             None
@@ -102,6 +104,7 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
         torch.cuda.set_rng_state_all(state["rng"]["cuda"])
     trainer.last_eval, trainer.full_eval = state["last_eval"], state["full_eval"]
     trainer.curriculum = state.get("curriculum")
+    warn_if_other_machine(trainer, state.get("machine"))
     m = state.get("update_metrics")
     trainer._update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
     ep = state["episode"]
@@ -122,6 +125,18 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
                 "warning: the replayed episode differs from the checkpoint's; the resumed "
                 "run will not match an uninterrupted one exactly"
             )
+
+
+def warn_if_other_machine(trainer: Any, saved_on: str | None) -> None:
+    """A run resumed on another kind of machine goes on correctly, but its bits part from the
+    uninterrupted run's at the first update (different kernels round differently), so
+    ``benchmarks/same_run.py`` against it will report a difference: say so once."""
+    here = machine_summary(trainer.device)
+    if saved_on is not None and saved_on != here:
+        trainer.reporter.log(
+            f"note: this state was saved on {saved_on}; this is {here}. The run goes on, "
+            "but will not match one that stayed on the first machine bit for bit"
+        )
 
 
 def diverged(trainer: Any, what: str) -> UserError:
@@ -179,6 +194,7 @@ def policy_file(trainer: Any) -> dict[str, Any]:
         "last_eval": trainer.last_eval,
         "full_eval": trainer.full_eval,
         "torch": str(torch.__version__),
+        "machine": machine_summary(trainer.device),  # since 2026-12-05
     }
     return policy_payload(
         trainer.agent.actor.state_dict(),

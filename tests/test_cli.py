@@ -70,6 +70,7 @@ def test_train_then_resume_then_eval_json(tmp_path, trained_run, capsys):
     assert data["summary"]["mean"] == pytest.approx(sum(returns) / 3)
     assert data["summary"]["min"] == pytest.approx(min(returns))
     assert data["summary"]["solved"] is False
+    assert data["summary"]["machine"].endswith(" kernels)")  # the CPU that played them
     assert "not solved" in out and f"{data['summary']['mean']:.1f}" in out
     # the same seeds give the same returns, whichever process runs them
     again = tmp_path / "again.json"

@@ -59,6 +59,7 @@ def test_select_copies_the_held_out_winner(tmp_path, kept_run, capsys):
     assert code == 0, err
     data = json.loads(report.read_text())
     assert data["seeds"] == [2_000_000, 2_000_001] and len(data["candidates"]) == 2
+    assert data["machine"].endswith(" kernels)")
     means = {r["path"]: r["held_out"]["mean"] for r in data["candidates"]}
     assert means[data["chosen"]] == max(means.values())
     chosen_step = load_checkpoint(data["chosen"])["meta"]["steps"]

@@ -5,8 +5,10 @@ import json
 from pathlib import Path
 
 import pytest
+import torch
 
 from bipedal_cli.checkpoint import actor_from_checkpoint, load_checkpoint
+from bipedal_cli.devices import machine_summary
 from bipedal_cli.evaluation import evaluate_actor
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -41,13 +43,20 @@ def test_shipped_policy_replays_its_reports_first_episodes(name):
         assert meta["full_eval"]["episodes"] == 100 and meta["full_eval"]["mean"] > 300
     actor, cfg = actor_from_checkpoint(data)
     episodes = evaluate_actor(actor, cfg.agent, env, [0, 1, 2, 3, 4], workers=1)
-    for got, want in zip(episodes, report["episodes"][:5], strict=True):
-        assert got.seed == want["seed"]
-        assert got.fell == want["fell"]
-        # Same chunk of 5 as `bipedal eval`: equal on the machine that wrote the report. On
-        # another CPU the float rounding of the matrix products differs and a 1,600-step walk
-        # amplifies it (seen: 304.2 against 305.6 on an AMD EPYC for an Intel Xeon's report).
-        assert got.ret == pytest.approx(want["ret"], rel=0.02)
+    assert [got.seed for got in episodes] == [want["seed"] for want in report["episodes"][:5]]
+    # Same chunk of 5 as `bipedal eval`: equal on the kind of machine that wrote the report
+    # (reports name it since session 33). On another CPU the float rounding of the matrix
+    # products differs and a 1,600-step walk amplifies it (seen: 304.2 against 305.6 on an AMD
+    # EPYC for an Intel Xeon's report), and a knife-edge episode can fall on one machine and
+    # not on the other (seen: Hardcore's seed 2, 142.0 with a fall in the AMD-era report, 308.3
+    # on an Intel Xeon with AVX512): one of the five may then flip, not more.
+    same_machine = report["summary"].get("machine") == machine_summary(torch.device("cpu"))
+    pairs = list(zip(episodes, report["episodes"][:5], strict=True))
+    flipped = [got.seed for got, want in pairs if got.fell != want["fell"]]
+    assert len(flipped) <= (0 if same_machine else 1), flipped
+    for got, want in pairs:
+        if got.seed not in flipped:
+            assert got.ret == pytest.approx(want["ret"], rel=1e-9 if same_machine else 0.02)
         if solved:
             assert not got.fell and got.ret > 300
 
