@@ -129,6 +129,8 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
     if type(episode.get("probe", False)) is not bool:  # since 2026-12-03
         raise _fail(where, "episode.probe", "should be true or false")
     _check_fall_memory(data.get("fall_memory") or [], act_dim, where)
+    if data.get("machine") is not None:  # since 2026-12-05: where it was saved
+        _get(data, "machine", str, where)
     _get(data, "rng", Mapping, where)
     _get(data, "recent_returns", list, where)
     if "recent_falls" in data:  # since 2026-11-24; older checkpoints start it empty

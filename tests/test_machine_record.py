@@ -6,11 +6,13 @@ difference."""
 
 from pathlib import Path
 
+import pytest
 import torch
 
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict
 from bipedal_cli.devices import machine_summary
+from bipedal_cli.errors import UserError
 from bipedal_cli.reporting import NullReporter
 from bipedal_cli.resume import resume
 from bipedal_cli.train import train
@@ -54,6 +56,16 @@ def test_a_run_records_its_machine_and_notes_a_resume_elsewhere(tmp_path):
         f"note: this state was saved on AMD EPYC 7B13 (AVX2 kernels); this is {here}. The run "
         "goes on, but will not match one that stayed on the first machine bit for bit"
     ]
+
+
+def test_a_damaged_machine_in_a_state_is_a_one_line_error(tmp_path):
+    train(config_from_dict(tiny_dict(total_steps=60)), tmp_path / "run")
+    state = torch.load(tmp_path / "run" / "state.pt", map_location="cpu", weights_only=False)
+    state["machine"] = 5
+    torch.save(state, tmp_path / "run" / "state.pt")
+    with pytest.raises(UserError, match=r"state\.pt.*machine") as err:
+        load_checkpoint(tmp_path / "run" / "state.pt")
+    assert "\n" not in str(err.value)
 
 
 def test_same_policy_names_two_machines_without_calling_them_a_difference(tmp_path, capsys):
