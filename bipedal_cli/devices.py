@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import platform
 
@@ -34,6 +35,7 @@ def configure_threads(train: TrainConfig, device: torch.device) -> bool:
     return split
 
 
+@functools.cache  # read once: every checkpoint and kept policy records it
 def cpu_name() -> str:
     """The CPU's model name (``/proc/cpuinfo`` on Linux), else what ``platform`` knows."""
     try:
