@@ -10,17 +10,12 @@ from concurrent.futures import Future, ThreadPoolExecutor
 import numpy as np
 import torch
 
+from .adam_moments import step_moments_only
 from .anchor import anchor_penalty, anchored
 from .config import AgentConfig
 from .losses import actor_loss, quantile_huber_loss, temperature_loss, truncated_target
 from .metrics_when_done import MetricsWhenDone
-from .networks import QuantileCritics, SquashedGaussianActor
-
-
-def make_actor(cfg: AgentConfig, obs_dim: int, act_dim: int) -> SquashedGaussianActor:
-    return SquashedGaussianActor(
-        obs_dim, act_dim, cfg.actor_hidden, cfg.n_layers, cfg.d2rl, cfg.log_std_min, cfg.log_std_max
-    )
+from .networks import QuantileCritics, SquashedGaussianActor, make_actor
 
 
 class TQCAgent:
@@ -143,15 +138,8 @@ class TQCAgent:
         as without the worker, so the results are equal to the bit.
         """
         self.sync()  # the actor loss reads the critics: their last step must be done
-        obs = batch["obs"]
-        # (2, B, A): eps[0] draws a ~ pi(.|s) for eqs. 2-3, eps[1] a' ~ pi(.|s') for the target
-        eps = torch.randn(
-            (2, obs.shape[0], self.act_dim),
-            generator=self.noise,
-            device=self.device,
-            dtype=obs.dtype,
-        )
-        alpha = self.log_alpha.detach().exp()
+        obs, alpha = batch["obs"], self.log_alpha.detach().exp()
+        eps = self._update_noise(obs)
         if self._worker is None:
             critic_metrics = self._critic_gradients(batch, eps[1], alpha)
             actor_metrics = self._actor_gradients(obs, eps[0], alpha)
@@ -252,15 +240,26 @@ class TQCAgent:
         theta <- theta - 0 * m_hat / (sqrt(v_hat) + eps): the parameters stay, the moments
         average the gradients (a fresh Adam's first steps are lr * sign(g) on every weight)."""
         for opt in (self.actor_opt, self.alpha_opt):
-            if not self.actor_frozen:
+            if self.actor_frozen:
+                step_moments_only(opt)
+            else:
                 opt.step()
-                continue
-            rates = [group["lr"] for group in opt.param_groups]
-            for group in opt.param_groups:
-                group["lr"] = 0.0
-            opt.step()
-            for group, lr in zip(opt.param_groups, rates, strict=True):
-                group["lr"] = lr
+
+    def _update_noise(self, obs: torch.Tensor) -> torch.Tensor:
+        """(2, B, A): eps[0] draws a ~ pi(.|s) for eqs. 2-3, eps[1] a' ~ pi(.|s') for the target."""
+        shape = (2, obs.shape[0], self.act_dim)
+        return torch.randn(shape, generator=self.noise, device=self.device, dtype=obs.dtype)
+
+    def accumulate_moments(self, batch: dict[str, torch.Tensor]) -> None:
+        """The gradients of :meth:`update` on ``batch``, into the actor's and critics' Adam
+        moments only (:func:`~bipedal_cli.adam_moments.step_moments_only`): no weight, target or
+        temperature moves (:func:`~bipedal_cli.adam_moments.estimate_moments`)."""
+        self.sync()
+        eps, alpha = self._update_noise(batch["obs"]), self.log_alpha.detach().exp()
+        self._critic_gradients(batch, eps[1], alpha)
+        self._actor_gradients(batch["obs"], eps[0], alpha)
+        step_moments_only(self.critic_opt)
+        step_moments_only(self.actor_opt)
 
     # ------------------------------------------------------------- persistence
     def state_dict(self) -> dict:

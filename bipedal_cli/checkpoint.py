@@ -147,8 +147,8 @@ def training_progress(data: dict[str, Any]) -> dict[str, Any]:
 
 def actor_from_checkpoint(data: dict[str, Any], option: str = "CKPT"):
     """Build the deterministic actor a policy or training-state checkpoint holds (on CPU)."""
-    from .agent import make_actor
     from .config import config_from_dict
+    from .networks import make_actor
 
     cfg = config_from_dict(data["config"], f"{option} {data.get('path', '')}: config".strip())
     actor = make_actor(cfg.agent, int(data["obs_dim"]), int(data["act_dim"]))

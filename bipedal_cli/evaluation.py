@@ -86,7 +86,7 @@ def actor_policy(actor: torch.nn.Module, device: torch.device | str = "cpu"):
 
 
 def _cpu_actor(agent_cfg: AgentConfig, dims: tuple[int, int], actor_state: dict):
-    from .agent import make_actor
+    from .networks import make_actor
 
     actor = make_actor(agent_cfg, *dims)
     actor.load_state_dict(actor_state)

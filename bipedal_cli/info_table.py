@@ -32,6 +32,7 @@ def checkpoint_table(data: dict, title: str) -> Table:
         meta = {
             **training_progress(data),
             "replay buffer": f"{int(data['buffer']['size']):,} transitions",
+            "adam moments": _adam_moments(data),
             "curriculum": data.get("curriculum"),
         }
     else:
@@ -61,3 +62,13 @@ def checkpoint_table(data: dict, title: str) -> Table:
         items = getattr(cfg, section).__dict__.items()
         table.add_row(section, ", ".join(f"{k}={v}" for k, v in items))
     return table
+
+
+def _adam_moments(data: dict) -> str:
+    """Whether a training state holds the actor's and critics' Adam moments
+    (:mod:`bipedal_cli.adam_moments`)."""
+    if data["agent"]["critic_opt"]["state"]:
+        return "kept"
+    if data.get("restart"):
+        return "left out (estimated again after the refill)"
+    return "none yet (no update made)"

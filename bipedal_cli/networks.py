@@ -15,6 +15,7 @@ matrix products over the ensemble dimension: N critics cost one call per layer, 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import torch
 from torch import nn
@@ -197,3 +198,10 @@ class QuantileCritics(nn.Module):
     ) -> torch.Tensor:
         """obs: (B, obs_dim), act: (B, act_dim) -> atoms theta: (B, N, M)."""
         return self.net(torch.cat([obs, act], dim=-1), detach_params=detach_params)
+
+
+def make_actor(cfg: Any, obs_dim: int, act_dim: int) -> SquashedGaussianActor:
+    """The actor of an :class:`~bipedal_cli.config.AgentConfig` (``cfg``)."""
+    return SquashedGaussianActor(
+        obs_dim, act_dim, cfg.actor_hidden, cfg.n_layers, cfg.d2rl, cfg.log_std_min, cfg.log_std_max
+    )

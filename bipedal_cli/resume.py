@@ -22,7 +22,13 @@ from .checkpoint import (
 from .config import Config, config_from_dict, override_config
 from .curriculum import continue_curriculum
 from .errors import UserError
-from .metrics import METRICS_FILE, MetricsWriter, parse_metrics, read_metrics
+from .metrics import (
+    METRICS_FILE,
+    MetricsWriter,
+    parse_metrics,
+    read_metrics,
+    restart_metrics_text,
+)
 from .paths import atomic_path, printable
 from .reporting import Reporter
 from .rundir import BRANCH_FILE, lock_run_dir, prepare_new_run_dir
@@ -173,7 +179,7 @@ def branch(
         trainer.load_state_dict(state)
         if restart is not None:
             trainer.refill_until = step + cfg.train.refill_steps
-            rows = parse_metrics(restart["metrics_csv"])
+            rows = parse_metrics(restart_metrics_text(restart))
             origin = f"restart file {state_path.resolve()} at step {step}"
         else:
             source_metrics = state_path.parent / METRICS_FILE

@@ -9,6 +9,7 @@ from typing import Any
 
 import torch
 
+from .adam_moments import estimate_moments, moments_missing
 from .schedule import (
     actor_frozen,
     actor_lowest_atoms,
@@ -30,6 +31,8 @@ def scheduled_updates(trainer: Any) -> Mapping[str, torch.Tensor] | None:
     agent.actor_lowest_atoms = actor_lowest_atoms(step, cfg.agent)
     agent.actor_frozen = actor_frozen(step, cfg.agent)
     batch_size = batch_size_at(step, cfg.agent)
+    if trainer.refill_until and moments_missing(agent):  # restarted from a restart file
+        estimate_moments(trainer, batch_size)
     metrics = None
     for _ in range(updates_at(step, cfg.train)):
         metrics = agent.update(

@@ -10,6 +10,7 @@ allocation.
 from __future__ import annotations
 
 import math
+import zlib
 from collections.abc import Mapping
 from typing import Any
 
@@ -17,6 +18,7 @@ import torch
 
 from .config import Config, config_from_dict
 from .errors import UserError
+from .metrics import restart_metrics_text
 from .validation import ACT_SIZE, OBS_SIZE
 
 AGENT_NETWORKS = ("actor", "critic", "critic_target")
@@ -38,8 +40,7 @@ def _get(data: Mapping, key: str, kind, where: str, path: str = "") -> Any:
 
 
 def _shapes(cfg: Config, obs_dim: int, act_dim: int) -> dict[str, dict[str, tuple[int, ...]]]:
-    from .agent import make_actor
-    from .networks import QuantileCritics
+    from .networks import QuantileCritics, make_actor
 
     a = cfg.agent
     with torch.device("meta"):
@@ -156,7 +157,15 @@ def _check_restart(data: dict, where: str) -> None:
     restart = _get(data, "restart", Mapping, where)
     if _get(restart, "step", int, where, "restart.") != data["counters"]["step"]:
         raise _fail(where, "restart.step", "should be counters.step")
-    _get(restart, "metrics_csv", str, where, "restart.")
+    if "metrics_csv_zlib" not in restart:
+        _get(restart, "metrics_csv", str, where, "restart.")
+    elif not isinstance(restart["metrics_csv_zlib"], bytes):
+        raise _fail(where, "restart.metrics_csv_zlib", "should be bytes")
+    else:
+        try:
+            restart_metrics_text(restart)
+        except (zlib.error, UnicodeDecodeError):
+            raise _fail(where, "restart.metrics_csv_zlib", "is not zlib-packed text") from None
     if data["buffer"]["size"] != 0:
         raise _fail(where, "buffer", "should be empty in a restart file")
 

@@ -37,7 +37,7 @@ def test_policy_checkpoint_round_trip_gives_identical_actions(tmp_path):
 
 
 def tiny_policy_payload(fill: float) -> dict:
-    from bipedal_cli.agent import make_actor
+    from bipedal_cli.networks import make_actor
 
     cfg = config_from_dict(tiny_dict())
     actor = make_actor(cfg.agent, 24, 4)

@@ -11,7 +11,7 @@ import pytest
 from bipedal_cli.branch_rules import BRANCH_MAY_CHANGE, _flat
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict, resolve_config
-from bipedal_cli.metrics import parse_metrics, read_metrics
+from bipedal_cli.metrics import parse_metrics, read_metrics, restart_metrics_text
 
 ROOT = Path(__file__).resolve().parent.parent
 RESTARTS = ROOT / "checkpoints" / "restarts"
@@ -39,11 +39,12 @@ def test_committed_restart_file_is_its_configs_run_with_the_committed_metrics(na
     committed_cfg = resolve_config(ROOT / "configs" / config, seed=seed)
     # the file's config is the committed one but for what changes no bit (threads, budget)
     assert flat(run_cfg.to_dict()) == flat(committed_cfg.to_dict())
-    rows = parse_metrics(data["restart"]["metrics_csv"])
+    text = restart_metrics_text(data["restart"])
+    rows = parse_metrics(text)
     assert rows and int(float(rows[-1]["step"])) <= step
     copy = read_metrics(ROOT / metrics)
     assert copy[: len(rows)] == rows, f"{metrics} is not the restart file's metrics"
-    header = next(csv.reader(io.StringIO(data["restart"]["metrics_csv"])))
+    header = next(csv.reader(io.StringIO(text)))
     assert header == list(copy[0])
 
 

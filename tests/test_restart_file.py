@@ -1,6 +1,7 @@
 """``restart.pt``: a run's state without its replay buffer, and ``bipedal resume FILE --into DIR``
 (the run goes on in a new directory after a refill of its buffer)."""
 
+import re
 import shutil
 
 import pytest
@@ -9,7 +10,7 @@ import torch
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict
 from bipedal_cli.errors import UserError
-from bipedal_cli.metrics import read_metrics
+from bipedal_cli.metrics import read_metrics, restart_metrics_text
 from bipedal_cli.resume import branch, resume
 from bipedal_cli.train import train
 
@@ -40,14 +41,16 @@ def test_restart_file_is_the_state_without_replay_and_with_the_metrics(stopped_r
     assert state["buffer"]["size"] == 230 and restart["buffer"]["size"] == 0
     assert restart["episode"]["obs"] is None and state["episode"]["obs"] is not None
     assert restart["restart"]["step"] == 230
-    assert restart["restart"]["metrics_csv"] == (stopped_run / "metrics.csv").read_text()
+    assert restart_metrics_text(restart["restart"]) == (stopped_run / "metrics.csv").read_text()
     for net in ("actor", "critic", "critic_target"):
         for key, value in state["agent"][net].items():
             assert torch.equal(value, restart["agent"][net][key]), (net, key)
-    moments = state["agent"]["critic_opt"]["state"]
-    assert all(
-        torch.equal(m["exp_avg_sq"], restart["agent"]["critic_opt"]["state"][i]["exp_avg_sq"])
-        for i, m in moments.items()
+    for opt in ("actor_opt", "critic_opt"):  # settings kept, moments left out (adam_moments.py)
+        assert state["agent"][opt]["state"] and restart["agent"][opt]["state"] == {}
+        assert restart["agent"][opt]["param_groups"] == state["agent"][opt]["param_groups"]
+    alpha_moments = state["agent"]["alpha_opt"]["state"][0]
+    assert torch.equal(
+        restart["agent"]["alpha_opt"]["state"][0]["exp_avg"], alpha_moments["exp_avg"]
     )
     assert restart["counters"] == state["counters"]
     assert torch.equal(restart["rng"]["torch"], state["rng"]["torch"])
@@ -61,6 +64,10 @@ def test_restart_refills_without_updates_then_learns(tmp_path, stopped_run):
     assert state["agent"]["updates"] == (230 - 100) + (400 - 290)
     assert state["counters"]["refill_until"] == 290
     assert state["buffer"]["size"] == 400 - 230  # what it has seen since the restart, alone
+    # the moments were estimated from the refilled buffer, then 110 updates ran: Adam's t
+    # counts K = 1 / (1 - b2) = 1,000 steps of size zero and 110 updates
+    steps = {float(m["step"]) for m in state["agent"]["critic_opt"]["state"].values()}
+    assert steps == {1000.0 + 110}
     rows = read_metrics(tmp_path / "restarted" / "metrics.csv")
     source_rows = read_metrics(stopped_run / "metrics.csv")
     assert rows[: len(source_rows)] == source_rows
@@ -122,6 +129,10 @@ def test_a_state_with_replay_posing_as_a_restart_file_is_refused(tmp_path, stopp
     torch.save(state, tmp_path / "bad.pt")
     with pytest.raises(UserError, match="'restart.step' should be counters.step"):
         load_checkpoint(tmp_path / "bad.pt")
+    state["restart"] = {"step": 230, "metrics_csv_zlib": b"not zlib"}
+    torch.save(state, tmp_path / "bad.pt")
+    with pytest.raises(UserError, match="'restart.metrics_csv_zlib' is not zlib-packed text"):
+        load_checkpoint(tmp_path / "bad.pt")
 
 
 def test_refill_steps_is_validated_and_may_change_in_a_branch(tmp_path, stopped_run):
@@ -139,6 +150,9 @@ def test_cli_continues_a_restart_file_and_info_names_it(tmp_path, stopped_run, c
     code, out, err = run_cli(["info", file], capsys)
     assert code == 0, err
     assert "restart file" in out and "0 transitions" in out
+    assert "left out (estimated again after the refill)" in out
+    code, out, err = run_cli(["info", stopped_run / "state.pt"], capsys)
+    assert code == 0 and re.search(r"adam moments\s+\S\s+kept", out), out
     code, out, err = run_cli(["resume", file], capsys)
     assert code == 2 and "--into DIR" in err and "Traceback" not in err
     into = tmp_path / "again"

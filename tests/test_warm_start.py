@@ -9,10 +9,10 @@ import pytest
 import torch
 import yaml
 
-from bipedal_cli.agent import make_actor
 from bipedal_cli.checkpoint import load_checkpoint
 from bipedal_cli.config import config_from_dict
 from bipedal_cli.errors import UserError
+from bipedal_cli.networks import make_actor
 from bipedal_cli.resume import resume
 from bipedal_cli.schedule import actor_frozen
 from bipedal_cli.train import Trainer, new_trainer, train
