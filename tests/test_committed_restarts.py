@@ -22,6 +22,11 @@ COMMITTED = {
         2,
         "docs/runs/hardcore-lrdecay-cvar25-seed2/metrics.csv",
     ),
+    "hardcore-lrdecay-cvar25-wide-seed0.pt": (
+        "hardcore-lrdecay-cvar25-wide.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-wide-seed0/metrics.csv",
+    ),
 }
 
 
