@@ -3,7 +3,7 @@ by the run that restarts from it, once its refill ends.
 
 Adam keeps two moments per weight, so the actor's and critics' optimizers are twice the size of
 the networks: with critics 512 wide, a restart file with them was 33 MiB, and without them (its
-metrics zlib-packed too) 16.1 MiB. A restart file leaves them out
+metrics zlib-packed too) about 16 MiB. A restart file leaves them out
 (:func:`without_moments`); the temperature's (one scalar) stays. Its run restarts with an
 emptied replay buffer anyway (the same agent, not the same run). At the first learning step
 after the refill, before the first update, it estimates the moments again
