@@ -173,12 +173,12 @@ def empty_buffer_state(buffer: Any) -> dict[str, Any]:
 def restart_state(trainer: Any, metrics_csv: str) -> dict[str, Any]:
     """The ``restart.pt`` of a run: :func:`run_state` without its replay buffer, its episode in
     progress and the actor's and critics' Adam moments (:mod:`bipedal_cli.adam_moments`), plus
-    the run's metrics up to here, zlib-packed: 16,958,525 bytes for the run with critics 512
-    wide at 1,000,786 policy steps, against about 0.8 GB for ``state.pt``. It is what a run needs
-    to go on after its directory is lost: networks, targets, the temperature and its optimizer,
-    counters and every RNG. Continued with ``bipedal resume FILE --into DIR``, the run first
-    refills its buffer (``train.refill_steps``) and estimates the moments again: the same agent
-    from the same step, not the same run."""
+    the run's metrics up to here, zlib-packed: about 16 MiB with critics 512 wide (``ls -l
+    checkpoints/restarts/*wide*.pt``), against about 0.8 GB for ``state.pt``. It is what a run
+    needs to go on after its directory is lost: networks, targets, the temperature and its
+    optimizer, counters and every RNG. Continued with ``bipedal resume FILE --into DIR``, the run
+    first refills its buffer (``train.refill_steps``) and estimates the moments again: the same
+    agent from the same step, not the same run."""
     state = run_state(trainer, replay=False)
     state["agent"] = without_moments(state["agent"])
     state["restart"] = {"step": trainer.step, "metrics_csv_zlib": pack_metrics(metrics_csv)}
