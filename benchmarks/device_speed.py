@@ -64,8 +64,16 @@ def updates_per_s(trainer, batch: int, count: int, sync: Callable[[], None]) -> 
 
 
 def measure(
-    config: str, device: str, batch: int, updates: int, steps: int, warmup: int, threads: int
+    config: str,
+    device: str,
+    batch: int,
+    updates: int,
+    steps: int,
+    warmup: int,
+    threads: int,
+    extra: tuple[str, ...] = (),
 ) -> dict:
+    """Both speeds of ``config`` with these settings; ``extra``: more ``key=value`` overrides."""
     import torch
 
     from bipedal_cli.config import resolve_config
@@ -83,7 +91,7 @@ def measure(
         "train.threads": threads,
         "train.buffer_size": 100_000,
     }
-    cfg = resolve_config(config, [f"{k}={v}" for k, v in overrides.items()])
+    cfg = resolve_config(config, [f"{k}={v}" for k, v in overrides.items()] + list(extra))
     sync = torch.cuda.synchronize if device.startswith("cuda") else (lambda: None)
     clock = Clock(sync)
     trainer = Trainer(cfg, tempfile.mkdtemp(prefix="bipedal-speed-"), clock)

@@ -15,7 +15,7 @@ from .anchor import anchor_penalty, anchored
 from .config import AgentConfig
 from .losses import actor_loss, quantile_huber_loss, temperature_loss, truncated_target
 from .metrics_when_done import MetricsWhenDone
-from .networks import QuantileCritics, SquashedGaussianActor, make_actor
+from .networks import SquashedGaussianActor, make_actor, make_critics
 
 
 class TQCAgent:
@@ -29,15 +29,7 @@ class TQCAgent:
         self._critic_step_job: Future | None = None  # the last update's, on the worker
         self.device = torch.device(device)
         self.actor = make_actor(cfg, obs_dim, act_dim).to(self.device)
-        self.critic = QuantileCritics(
-            obs_dim,
-            act_dim,
-            cfg.critic_hidden,
-            cfg.n_layers,
-            cfg.n_critics,
-            cfg.n_quantiles,
-            cfg.d2rl,
-        ).to(self.device)
+        self.critic = make_critics(cfg, obs_dim, act_dim).to(self.device)
         self.critic_target = copy.deepcopy(self.critic).requires_grad_(False)
         self.log_alpha = torch.tensor(
             float(np.log(cfg.init_alpha)), device=self.device, requires_grad=True

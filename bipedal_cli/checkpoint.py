@@ -174,6 +174,8 @@ def check_dims(data: dict[str, Any], obs_dim: int, act_dim: int, env_id: str, op
 POLICY_SHAPE_KEYS = (
     "action_repeat",
     "history",
+    "encoder",
+    "encoder_hidden",
     "actor_hidden",
     "n_layers",
     "d2rl",
@@ -196,11 +198,13 @@ def initial_actor_state(cfg: Any, obs_dim: int, act_dim: int) -> dict[str, torch
             raise UserError(
                 f"{option} {path}: its sha256 is {got}, train.init_policy_sha256 expects {want}"
             )
-    theirs = data["config"]["agent"]
+    from .config import config_from_dict
+
+    theirs = config_from_dict(data["config"], f"{option} {path}: config").agent  # all keys
     for key in POLICY_SHAPE_KEYS:
-        if theirs[key] != getattr(cfg.agent, key):
+        if getattr(theirs, key) != getattr(cfg.agent, key):
             raise UserError(
-                f"{option} {path}: its agent.{key} is {theirs[key]!r}, this config's is "
+                f"{option} {path}: its agent.{key} is {getattr(theirs, key)!r}, this config's is "
                 f"{getattr(cfg.agent, key)!r}; expected a policy of the same shape and inputs"
             )
     check_dims(data, obs_dim, act_dim, cfg.env, option)

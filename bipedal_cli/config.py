@@ -73,6 +73,12 @@ class AgentConfig:
     history: int = 1
     """H: the networks see the last H observations (oldest first, H * 24 inputs). Part of the
     policy, like ``action_repeat``."""
+    encoder: str = "none"
+    """What the actor and the critics read of the H observations: ``none``, the flattened
+    window; ``lstm``, an LSTM's last hidden state over the window beside the newest observation
+    (:mod:`~bipedal_cli.encoders`; the critics share one, the actor has its own)."""
+    encoder_hidden: int = 64
+    """Width of the ``lstm`` encoder's hidden and cell state."""
     n_step: int = 1
     """n: targets sum n rewards, y = sum_{j<n} gamma^j r_{t+j} + gamma^n (1 - d) (z - alpha
     log pi); an episode's end inside the n steps cuts the sum (termination also the

@@ -14,6 +14,7 @@ our Python code, so loading needs nothing of this package.
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import torch
@@ -48,7 +49,10 @@ def export_policy(
     module = actor if history == 1 else _HistoryPolicy(actor)
     example = torch.zeros(batch_hint, *input_shape(actor.obs_dim, history))
     batch = torch.export.Dim("batch", min=1, max=1 << 20)
-    with torch.no_grad():
+    with torch.no_grad(), warnings.catch_warnings():
+        # nn.LSTM (agent.encoder: lstm) rebuilds its flat weight list while it is traced; the
+        # exported program holds the weights all the same (tests/test_hardcore_features.py)
+        warnings.filterwarnings("ignore", "The tensor attributes .*_flat_weights")
         program = torch.export.export(module, (example,), dynamic_shapes=({0: batch},))
     meta = {
         "input_shape": ["B", *input_shape(actor.obs_dim, history)],

@@ -53,7 +53,9 @@ def checkpoint_table(data: dict, title: str) -> Table:
     a = cfg.agent
     table.add_row(
         "policy",
-        f"last {a.history} observation(s); each action held for {a.action_repeat} env step(s)",
+        f"last {a.history} observation(s)"
+        + (f" read by an LSTM of width {a.encoder_hidden}" if a.encoder == "lstm" else "")
+        + f"; each action held for {a.action_repeat} env step(s)",
     )
     for key, value in meta.items():
         table.add_row(key.replace("_", " "), _brief(value))

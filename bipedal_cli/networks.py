@@ -1,16 +1,5 @@
-"""D2RL networks: a dense MLP ensemble, the squashed-Gaussian actor and the quantile critics.
-
-D2RL (Sinha et al. 2020) concatenates the network input x to the output of every hidden layer
-except the last::
-
-    h_1 = relu(W_1 x + b_1)
-    h_l = relu(W_l [h_{l-1}, x] + b_l)        l = 2..L
-    out = W_o h_L + b_o
-
-``W_l [h, x]`` equals ``W_l^h h + W_l^x x``, so the x-parts of every layer of every ensemble
-member are computed by one matrix product up front, and each member's hidden layers are batched
-matrix products over the ensemble dimension: N critics cost one call per layer, not N.
-"""
+"""The squashed-Gaussian actor and the quantile critics over D2RL dense networks
+(:mod:`~bipedal_cli.dense`), and their factories from an agent config."""
 
 from __future__ import annotations
 
@@ -21,88 +10,16 @@ import torch
 from torch import nn
 from torch.nn import functional as F
 
-
-class DenseEnsemble(nn.Module):
-    """``ensemble`` independent (D2RL or plain) MLPs that share their input.
-
-    Parameters, per layer l (E members, H hidden, P layers that read x: L with D2RL, else 1):
-    ``w_x[l]`` (in_dim, E*H) the x-part, ``w_h[l-1]`` (E, H, H) the h-part, ``b[l]`` (E, 1, H);
-    ``w_out`` (E, H, out_dim), ``b_out`` (E, 1, out_dim). Separate tensors per layer: slicing one
-    packed tensor would cost a zero-fill and a copy of its gradient in every backward pass.
-    Initialisation matches ``nn.Linear``: U(-1/sqrt(fan_in), 1/sqrt(fan_in)) per member, with
-    fan_in = H + in_dim for the layers that see the concatenated input.
-    """
-
-    def __init__(
-        self,
-        in_dim: int,
-        out_dim: int,
-        hidden: int,
-        n_layers: int,
-        ensemble: int = 1,
-        d2rl: bool = True,
-    ) -> None:
-        super().__init__()
-        self.in_dim, self.out_dim, self.hidden = in_dim, out_dim, hidden
-        self.n_layers, self.ensemble, self.d2rl = n_layers, ensemble, d2rl
-        E, H = ensemble, hidden
-        n_proj = n_layers if d2rl else 1  # layers that read x directly
-        self.w_x = nn.ParameterList(
-            [nn.Parameter(torch.empty(in_dim, E * H)) for _ in range(n_proj)]
-        )
-        self.w_h = nn.ParameterList(
-            [nn.Parameter(torch.empty(E, H, H)) for _ in range(n_layers - 1)]
-        )
-        self.b = nn.ParameterList([nn.Parameter(torch.empty(E, 1, H)) for _ in range(n_layers)])
-        self.w_out = nn.Parameter(torch.empty(E, H, out_dim))
-        self.b_out = nn.Parameter(torch.empty(E, 1, out_dim))
-        self.reset_parameters()
-
-    def _fan_in(self, layer: int) -> int:
-        if layer == 0:
-            return self.in_dim
-        return self.hidden + (self.in_dim if self.d2rl else 0)
-
-    @torch.no_grad()
-    def reset_parameters(self) -> None:
-        for layer in range(self.n_layers):
-            bound = 1.0 / math.sqrt(self._fan_in(layer))
-            if layer < len(self.w_x):
-                self.w_x[layer].uniform_(-bound, bound)
-            if layer > 0:
-                self.w_h[layer - 1].uniform_(-bound, bound)
-            self.b[layer].uniform_(-bound, bound)
-        bound = 1.0 / math.sqrt(self.hidden)
-        self.w_out.uniform_(-bound, bound)
-        self.b_out.uniform_(-bound, bound)
-
-    def forward(self, x: torch.Tensor, detach_params: bool = False) -> torch.Tensor:
-        """x: (B, in_dim) -> (B, ensemble, out_dim).
-
-        ``detach_params`` runs the same function with the parameters cut from autograd: the actor
-        loss needs dQ/da through the critics but no gradient for the critics' weights, and this
-        skips computing them.
-        """
-
-        def p(t: torch.Tensor) -> torch.Tensor:
-            return t.detach() if detach_params else t
-
-        B, E, H = x.shape[0], self.ensemble, self.hidden
-
-        def x_part(layer: int) -> torch.Tensor:  # W_l^x x for every member: (E, B, H)
-            return (x @ p(self.w_x[layer])).view(B, E, H).transpose(0, 1)
-
-        h = F.relu(x_part(0) + p(self.b[0]))  # (E, B, H)
-        for layer in range(1, self.n_layers):
-            bias = p(self.b[layer])
-            pre = bias + x_part(layer) if self.d2rl else bias.expand(E, B, H)
-            h = F.relu(torch.baddbmm(pre, h, p(self.w_h[layer - 1])))  # (E, B, H)
-        out = torch.baddbmm(p(self.b_out), h, p(self.w_out))  # (E, B, out_dim)
-        return out.transpose(0, 1)  # (B, E, out_dim)
+from .dense import DenseEnsemble
+from .encoders import make_encoder
 
 
 class SquashedGaussianActor(nn.Module):
-    """pi(a|s): u ~ N(mu(s), sigma(s)^2), a = tanh(u); deterministic action tanh(mu(s))."""
+    """pi(a|s): u ~ N(mu(s), sigma(s)^2), a = tanh(u); deterministic action tanh(mu(s)).
+
+    With an ``encoder`` (:mod:`~bipedal_cli.encoders`) the dense network reads encoder(s), and
+    the actor's loss trains both.
+    """
 
     def __init__(
         self,
@@ -113,15 +30,19 @@ class SquashedGaussianActor(nn.Module):
         d2rl: bool = True,
         log_std_min: float = -20.0,
         log_std_max: float = 2.0,
+        encoder: nn.Module | None = None,
     ) -> None:
         super().__init__()
         self.obs_dim, self.act_dim = obs_dim, act_dim
-        self.net = DenseEnsemble(obs_dim, 2 * act_dim, hidden, n_layers, 1, d2rl)
+        self.encoder = encoder
+        in_dim = obs_dim if encoder is None else encoder.out_dim
+        self.net = DenseEnsemble(in_dim, 2 * act_dim, hidden, n_layers, 1, d2rl)
         self.log_std_min, self.log_std_max = log_std_min, log_std_max
 
     def distribution_params(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """obs: (B, obs_dim) -> mean, log_std: (B, act_dim) each, log_std clamped."""
-        out = self.net(obs)[:, 0]  # (B, 2 * act_dim)
+        x = obs if self.encoder is None else self.encoder(obs)  # (B, in_dim)
+        out = self.net(x)[:, 0]  # (B, 2 * act_dim)
         mean, log_std = out.chunk(2, dim=-1)
         return mean, log_std.clamp(self.log_std_min, self.log_std_max)
 
@@ -177,7 +98,10 @@ def squashed_gaussian_log_prob(
 
 
 class QuantileCritics(nn.Module):
-    """N distributional critics Z_psi_n(s, a), each M quantile atoms: output (B, N, M)."""
+    """N distributional critics Z_psi_n(s, a), each M quantile atoms: output (B, N, M).
+
+    With an ``encoder`` the N critics share it: Z_psi_n(encoder(s), a), one encoding per batch.
+    """
 
     def __init__(
         self,
@@ -188,20 +112,52 @@ class QuantileCritics(nn.Module):
         n_critics: int = 5,
         n_quantiles: int = 25,
         d2rl: bool = True,
+        encoder: nn.Module | None = None,
     ) -> None:
         super().__init__()
         self.n_critics, self.n_quantiles = n_critics, n_quantiles
-        self.net = DenseEnsemble(obs_dim + act_dim, n_quantiles, hidden, n_layers, n_critics, d2rl)
+        self.encoder = encoder
+        in_dim = (obs_dim if encoder is None else encoder.out_dim) + act_dim
+        self.net = DenseEnsemble(in_dim, n_quantiles, hidden, n_layers, n_critics, d2rl)
 
     def forward(
         self, obs: torch.Tensor, act: torch.Tensor, detach_params: bool = False
     ) -> torch.Tensor:
-        """obs: (B, obs_dim), act: (B, act_dim) -> atoms theta: (B, N, M)."""
-        return self.net(torch.cat([obs, act], dim=-1), detach_params=detach_params)
+        """obs: (B, obs_dim), act: (B, act_dim) -> atoms theta: (B, N, M).
+
+        ``detach_params`` encodes obs without autograd: dZ/da needs no path through the
+        encoder, whose input is data.
+        """
+        x = obs
+        if self.encoder is not None:
+            with torch.set_grad_enabled(torch.is_grad_enabled() and not detach_params):
+                x = self.encoder(obs)  # (B, encoder.out_dim)
+        return self.net(torch.cat([x, act], dim=-1), detach_params=detach_params)
 
 
 def make_actor(cfg: Any, obs_dim: int, act_dim: int) -> SquashedGaussianActor:
     """The actor of an :class:`~bipedal_cli.config.AgentConfig` (``cfg``)."""
     return SquashedGaussianActor(
-        obs_dim, act_dim, cfg.actor_hidden, cfg.n_layers, cfg.d2rl, cfg.log_std_min, cfg.log_std_max
+        obs_dim,
+        act_dim,
+        cfg.actor_hidden,
+        cfg.n_layers,
+        cfg.d2rl,
+        cfg.log_std_min,
+        cfg.log_std_max,
+        make_encoder(cfg, obs_dim),
+    )
+
+
+def make_critics(cfg: Any, obs_dim: int, act_dim: int) -> QuantileCritics:
+    """The critics of an :class:`~bipedal_cli.config.AgentConfig` (``cfg``)."""
+    return QuantileCritics(
+        obs_dim,
+        act_dim,
+        cfg.critic_hidden,
+        cfg.n_layers,
+        cfg.n_critics,
+        cfg.n_quantiles,
+        cfg.d2rl,
+        make_encoder(cfg, obs_dim),
     )

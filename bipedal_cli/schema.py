@@ -40,14 +40,12 @@ def _get(data: Mapping, key: str, kind, where: str, path: str = "") -> Any:
 
 
 def _shapes(cfg: Config, obs_dim: int, act_dim: int) -> dict[str, dict[str, tuple[int, ...]]]:
-    from .networks import QuantileCritics, make_actor
+    from .networks import make_actor, make_critics
 
     a = cfg.agent
     with torch.device("meta"):
         actor = make_actor(a, obs_dim, act_dim)
-        critic = QuantileCritics(
-            obs_dim, act_dim, a.critic_hidden, a.n_layers, a.n_critics, a.n_quantiles, a.d2rl
-        )
+        critic = make_critics(a, obs_dim, act_dim)
     actor_shapes = {k: tuple(v.shape) for k, v in actor.state_dict().items()}
     critic_shapes = {k: tuple(v.shape) for k, v in critic.state_dict().items()}
     return {"actor": actor_shapes, "critic": critic_shapes, "critic_target": critic_shapes}

@@ -36,6 +36,8 @@ def check_count(option: str, value: int, limit: int = MAX_EPISODES, low: int = 1
         raise UserError(f"{option} {value}: expected an integer in [{low}, {limit:,}]")
 
 
+ENCODERS = ("none", "lstm")  # agent.encoder: encoders.py
+
 MAX_THREADS = 256  # torch.set_num_threads(100000) crashes the process
 
 
@@ -87,6 +89,8 @@ def validate(cfg: Any, source: str) -> None:
         (a.batch_size_start >= 0, "agent.batch_size_start", "a non-negative step"),
         (a.action_repeat >= 1, "agent.action_repeat", "a positive integer"),
         (a.history >= 1, "agent.history", "a positive integer"),
+        (a.encoder in ENCODERS, "agent.encoder", " or ".join(ENCODERS)),
+        (1 <= a.encoder_hidden <= 4096, "agent.encoder_hidden", "an integer in [1, 4096]"),
         (a.n_step >= 1, "agent.n_step", "a positive integer"),
         (a.lr_final is None or a.lr_final >= 0, "agent.lr_final", "null or a number >= 0"),
         (a.lr_decay_start >= 0, "agent.lr_decay_start", "a non-negative integer"),

@@ -1,6 +1,7 @@
 """The TQC update: every gradient at the same parameters, and the two-thread split exact."""
 
 import copy
+import dataclasses
 
 import pytest
 import torch
@@ -20,9 +21,13 @@ SMALL = AgentConfig(
 )
 
 
-def make_agent(worker: bool) -> TQCAgent:
+# the same with an LSTM over a window of 3 observations of 2 floats (encoders.py)
+SMALL_LSTM = dataclasses.replace(SMALL, history=3, encoder="lstm", encoder_hidden=4)
+
+
+def make_agent(worker: bool, cfg: AgentConfig = SMALL) -> TQCAgent:
     torch.manual_seed(0)
-    agent = TQCAgent(SMALL, OBS, ACT)
+    agent = TQCAgent(cfg, OBS, ACT)
     agent.noise.manual_seed(1)
     if worker:
         agent.start_worker()
@@ -41,9 +46,10 @@ def make_batch(seed: int, act_dim: int = ACT) -> dict[str, torch.Tensor]:
     }
 
 
-def test_update_on_a_worker_thread_is_bit_identical_to_one_thread():
+@pytest.mark.parametrize("cfg", [SMALL, SMALL_LSTM], ids=["flat", "lstm"])
+def test_update_on_a_worker_thread_is_bit_identical_to_one_thread(cfg):
     torch.set_num_threads(1)
-    plain, split = make_agent(worker=False), make_agent(worker=True)
+    plain, split = make_agent(worker=False, cfg=cfg), make_agent(worker=True, cfg=cfg)
     try:
         for i in range(25):
             batch = make_batch(i)
@@ -63,11 +69,12 @@ def test_update_on_a_worker_thread_is_bit_identical_to_one_thread():
                 assert torch.equal(value, b[opt]["state"][key][name]), (opt, name)
 
 
+@pytest.mark.parametrize("cfg", [SMALL, SMALL_LSTM], ids=["flat", "lstm"])
 @pytest.mark.parametrize("worker", [False, True])
-def test_all_gradients_are_taken_at_the_parameters_before_the_update(worker):
+def test_all_gradients_are_taken_at_the_parameters_before_the_update(worker, cfg):
     """The paper's algorithm: grad J_Z, grad J_pi and grad J(alpha) all at (psi, phi, alpha)."""
     torch.set_num_threads(1)
-    agent = make_agent(worker)
+    agent = make_agent(worker, cfg)
     for i in range(3):  # move away from the initial parameters (Adam state included)
         agent.update(make_batch(100 + i))
     before = copy.deepcopy(agent.state_dict())
@@ -80,7 +87,7 @@ def test_all_gradients_are_taken_at_the_parameters_before_the_update(worker):
         agent.stop_worker()
 
     # The same gradients from a copy holding the parameters before the update.
-    ref = make_agent(worker=False)
+    ref = make_agent(worker=False, cfg=cfg)
     ref.load_state_dict(before)
     alpha = ref.log_alpha.detach().exp()
     with torch.no_grad():

@@ -44,6 +44,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-g99-probes-late": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-g99-utd2": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-wide": HARDCORE_H4,
+    "hardcore-lstm12": HARDCORE_H4[:3] + (12,) + HARDCORE_H4[4:],
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
     "hardcore-warm-kl100": HARDCORE_H4,
@@ -173,6 +174,20 @@ def test_hardcore_lrdecay_cvar25_wide_is_its_seed_0_run_but_for_the_critics_widt
     assert wide.agent.actor_hidden == 512
     wide.seed, wide.agent.critic_hidden = 1, 256
     assert wide == cvar
+
+
+def test_hardcore_lstm12_is_its_seed_0_run_but_for_the_window_and_its_lstm():
+    """Session 38's run from scratch: hardcore-lrdecay-cvar25.yaml's seed-0 run with 12
+    observations read by an LSTM of width 64 instead of 4 flat ones; nothing else may differ."""
+    cvar, lstm = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-lrdecay-cvar25", "hardcore-lstm12")
+    )
+    a = lstm.agent
+    assert (lstm.seed, a.history, a.encoder, a.encoder_hidden) == (0, 12, "lstm", 64)
+    assert cvar.agent.encoder == "none"
+    lstm.seed, a.history, a.encoder = 1, 4, "none"
+    assert lstm == cvar  # encoder_hidden is 64 in both: it is read only with an encoder
 
 
 RESTART_KEYS = tuple(

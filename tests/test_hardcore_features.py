@@ -19,18 +19,20 @@ from .conftest import tiny_dict
 from .test_train import assert_states_equal
 
 FEATURES = {"action_repeat": 2, "history": 3, "n_step": 3}
+LSTM = {**FEATURES, "encoder": "lstm", "encoder_hidden": 8}  # the window read by an LSTM
 SHAPING = {"fall_penalty": -7.0, "reward_scale": 2.0}
 
 
-def featured(**train_keys) -> dict:
+def featured(agent: dict = FEATURES, **train_keys) -> dict:
     data = tiny_dict(**SHAPING, **train_keys)
-    data["agent"].update(FEATURES)
+    data["agent"].update(agent)
     return data
 
 
-def test_resume_is_exact_with_every_hardcore_feature_on(tmp_path):
-    straight = train(config_from_dict(featured(total_steps=400)), tmp_path / "straight")
-    train(config_from_dict(featured(total_steps=230)), tmp_path / "split")
+@pytest.mark.parametrize("agent", [FEATURES, LSTM], ids=["flat", "lstm"])
+def test_resume_is_exact_with_every_hardcore_feature_on(tmp_path, agent):
+    straight = train(config_from_dict(featured(agent, total_steps=400)), tmp_path / "straight")
+    train(config_from_dict(featured(agent, total_steps=230)), tmp_path / "split")
     second = resume(tmp_path / "split", total_steps=400)
     assert straight.episodes == second.episodes >= 2
     a = load_checkpoint(tmp_path / "straight" / "state.pt")
@@ -59,8 +61,9 @@ def test_metrics_keep_the_env_return_apart_from_the_shaped_one(tmp_path):
         assert 2 * int(r["step"]) - i <= int(r["env_steps"]) <= 2 * int(r["step"])
 
 
-def test_evaluation_runs_the_policy_with_its_repeat_and_history(tmp_path):
-    train(config_from_dict(featured(total_steps=150)), tmp_path / "run")
+@pytest.mark.parametrize("agent", [FEATURES, LSTM], ids=["flat", "lstm"])
+def test_evaluation_runs_the_policy_with_its_repeat_and_history(tmp_path, agent):
+    train(config_from_dict(featured(agent, total_steps=150)), tmp_path / "run")
     data = load_checkpoint(tmp_path / "run" / "policy.pt")
     actor, cfg = actor_from_checkpoint(data)
     assert data["obs_dim"] == 3 * 24
@@ -75,7 +78,7 @@ def test_evaluation_runs_the_policy_with_its_repeat_and_history(tmp_path):
         action = policy(np.concatenate(frames)[None].astype(np.float32))[0]
         for _ in range(2):
             obs, r, term, trunc, _ = env.step(action)
-            ret, length = ret + r, length + 1
+            ret, length = ret + float(r), length + 1  # as the evaluation sums
             done = term or trunc
             if done:
                 break
@@ -83,10 +86,11 @@ def test_evaluation_runs_the_policy_with_its_repeat_and_history(tmp_path):
     assert (result.ret, result.length) == (ret, length)
 
 
-def test_export_takes_the_observation_history(tmp_path):
+@pytest.mark.parametrize("agent", [FEATURES, LSTM], ids=["flat", "lstm"])
+def test_export_takes_the_observation_history(tmp_path, agent):
     from bipedal_cli.cli import main
 
-    train(config_from_dict(featured(total_steps=150)), tmp_path / "run")
+    train(config_from_dict(featured(agent, total_steps=150)), tmp_path / "run")
     out = tmp_path / "p.pt2"
     try:
         main(["export", str(tmp_path / "run" / "policy.pt"), "--out", str(out)])
