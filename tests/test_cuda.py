@@ -21,7 +21,7 @@ from bipedal_cli.resume import resume
 from bipedal_cli.train import train
 
 from .reference import ref_actor_cvar_loss, ref_actor_loss, ref_critic_loss, ref_target
-from .test_hardcore_features import featured
+from .test_hardcore_features import FEATURES, LSTM, featured
 from .test_train import assert_states_equal
 
 pytestmark = pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA GPU")
@@ -116,8 +116,8 @@ def test_actor_loss_on_the_gpu_matches_the_reference(lowest):
         assert torch.allclose(a.cpu(), b, rtol=1e-12, atol=1e-15)
 
 
-def on_cuda(total_steps: int) -> dict:
-    data = featured(total_steps=total_steps)
+def on_cuda(total_steps: int, agent: dict = FEATURES) -> dict:
+    data = featured(agent, total_steps=total_steps)
     data["device"] = GPU
     data["agent"].update({"actor_cvar": 0.25, "actor_cvar_start": 150})
     return data
@@ -127,11 +127,13 @@ def without_path(state: dict) -> dict:
     return {k: v for k, v in state.items() if k != "path"}
 
 
-def test_a_cuda_run_repeats_and_resumes_to_the_bit(tmp_path):
-    """Same seed, same GPU: the same run; stopped at 230 and resumed, the run not stopped."""
-    first = train(config_from_dict(on_cuda(400)), tmp_path / "first")
-    again = train(config_from_dict(on_cuda(400)), tmp_path / "again")
-    train(config_from_dict(on_cuda(230)), tmp_path / "split")
+@pytest.mark.parametrize("agent", [FEATURES, LSTM], ids=["flat", "lstm"])
+def test_a_cuda_run_repeats_and_resumes_to_the_bit(tmp_path, agent):
+    """Same seed, same GPU: the same run; stopped at 230 and resumed, the run not stopped. With
+    an LSTM encoder too: cuDNN's LSTM is one of the kernels where that can fail."""
+    first = train(config_from_dict(on_cuda(400, agent)), tmp_path / "first")
+    again = train(config_from_dict(on_cuda(400, agent)), tmp_path / "again")
+    train(config_from_dict(on_cuda(230, agent)), tmp_path / "split")
     resumed = resume(tmp_path / "split", total_steps=400)
     assert first.episodes == again.episodes == resumed.episodes >= 2
     states = {n: load_checkpoint(tmp_path / n / "state.pt") for n in ("first", "again", "split")}
