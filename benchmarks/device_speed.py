@@ -104,6 +104,16 @@ def measure(
     }
 
 
+def run_child(cmd: list[str]) -> dict:
+    """Run one measurement in its own process: the dict it printed after ``RESULT``, or
+    ``{"error": the end of its stderr}``."""
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    lines = [x for x in proc.stdout.splitlines() if x.startswith("RESULT ")]
+    if not lines:
+        return {"error": proc.stderr.strip()[-300:]}
+    return json.loads(lines[-1][len("RESULT ") :])
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--config", default="configs/hardcore-lrdecay-cvar25-g99.yaml")
@@ -144,12 +154,10 @@ def main() -> None:
                 batch,
                 updates,
             ]
-            proc = subprocess.run(cmd, capture_output=True, text=True)
-            lines = [x for x in proc.stdout.splitlines() if x.startswith("RESULT ")]
-            if not lines:
-                print(f"| {device} | {variant} | failed: {proc.stderr.strip()[-300:]} | |")
+            r = run_child(cmd)
+            if "error" in r:
+                print(f"| {device} | {variant} | failed: {r['error']} | |")
                 continue
-            r = json.loads(lines[-1][len("RESULT ") :])
             name = f"{device} ({args.cpu_threads} thread)" if device == "cpu" else device
             print(
                 f"| {name} | {batch} x {updates} | {r['policy_steps_per_s']:.1f} "

@@ -16,10 +16,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 
-from device_speed import measure
+from device_speed import measure, run_child
 from record import run_recorded
 
 
@@ -52,13 +51,11 @@ def main() -> None:
         kind, history, *width = variant.split(":")
         cmd = [sys.executable, __file__, "--config", args.config, "--steps", str(args.steps)]
         cmd += ["--warmup", str(args.warmup), "--threads", str(args.threads), "--child", variant]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        lines = [x for x in proc.stdout.splitlines() if x.startswith("RESULT ")]
+        r = run_child(cmd)
         label = f"| {kind} | {history} | {width[0] if width else '-'} |"
-        if not lines:
-            print(f"{label} failed: {proc.stderr.strip()[-300:]} | |")
+        if "error" in r:
+            print(f"{label} failed: {r['error']} | |")
             continue
-        r = json.loads(lines[-1][len("RESULT ") :])
         print(f"{label} {r['policy_steps_per_s']:.1f} | {r['updates_per_s']:.1f} |", flush=True)
 
 
