@@ -27,6 +27,11 @@ COMMITTED = {
         0,
         "docs/runs/hardcore-lrdecay-cvar25-wide-seed0/metrics.csv",
     ),
+    "hardcore-lstm12-seed0.pt": (
+        "hardcore-lstm12.yaml",
+        0,
+        "docs/runs/hardcore-lstm12-seed0/metrics.csv",
+    ),
 }
 
 
