@@ -72,7 +72,8 @@ def test_the_encoder_reads_the_env_window_oldest_first():
         action = rng.uniform(-1, 1, 4).astype(np.float32)
         stacked, *_ = env.step(action)
         seen.append(plain.step(action)[0])
-    env.close(), plain.close()
+    env.close()
+    plain.close()
     frames = [torch.as_tensor(o, dtype=torch.float64)[None] for o in seen[-4:]]
     got = enc(torch.as_tensor(stacked, dtype=torch.float64)[None])
     torch.testing.assert_close(got, reference_lstm(frames, enc.lstm), rtol=1e-12, atol=1e-12)
