@@ -4,6 +4,11 @@
         docs/runs/hardcore-lrdecay-seed0 --from 1100000
     python benchmarks/compare_evals.py docs/runs/hardcore-lrdecay-seed0 \\
         docs/runs/hardcore-h8-curated-seed0 --to 300000     # two runs at equal steps
+    python benchmarks/compare_evals.py docs/runs/hardcore-lrdecay-cvar25-seed0 \\
+        docs/runs/hardcore-lrdecay-cvar25-ar2-seed0 --env-steps --to 3000000
+
+With ``--env-steps`` the window and the rows count env steps instead of policy steps: runs with
+different action repeats compare at equal experience.
 
 Prints one row per evaluation step (each run's mean and falls there), then per run: how many
 evaluations, their mean and median, the best, the mean falls per evaluation, every 100-episode
@@ -25,23 +30,29 @@ from bipedal_cli.metrics import COLUMNS, FRESH_KINDS, METRICS_FILE, read_metrics
 
 
 def evaluations(
-    path: Path, first: int, kind: str = "eval", last: int | None = None
+    path: Path, first: int, kind: str = "eval", last: int | None = None, axis: str = "step"
 ) -> dict[int, tuple[float, int]]:
+    """{position: (mean return, falls)} of the ``kind`` rows with ``first`` <= position <=
+    ``last``, where position is the row's ``axis`` column: "step" (policy steps) or
+    "env_steps"."""
     rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
+    end = last if last is not None else 1 << 62
     return {
-        int(r["step"]): (float(r["return"]), int(float(r["fell"])))
+        int(r[axis]): (float(r["return"]), int(float(r["fell"])))
         for r in rows
-        if r["kind"] == kind and first <= int(r["step"]) <= (last if last is not None else 1 << 62)
+        if r["kind"] == kind and first <= int(r[axis]) <= end
     }
 
 
-def training_episodes(path: Path, first: int, last: int | None = None) -> tuple[int, float, float]:
+def training_episodes(
+    path: Path, first: int, last: int | None = None, axis: str = "step"
+) -> tuple[int, float, float]:
     """Fresh training episodes (probes of the deterministic policy included, restarts near
-    falls not) ending after ``first`` (and at or before ``last``): count, mean env return,
-    fraction that fell."""
+    falls not) ending after ``first`` (and at or before ``last``) on ``axis``: count, mean env
+    return, fraction that fell."""
     rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
     end = last if last is not None else 1 << 62
-    mine = [r for r in rows if r["kind"] in FRESH_KINDS and first < int(r["step"]) <= end]
+    mine = [r for r in rows if r["kind"] in FRESH_KINDS and first < int(r[axis]) <= end]
     if not mine:
         return 0, float("nan"), float("nan")
     returns = [float(r["return"]) for r in mine]
@@ -49,14 +60,14 @@ def training_episodes(path: Path, first: int, last: int | None = None) -> tuple[
     return len(mine), statistics.mean(returns), statistics.mean(falls)
 
 
-def shared_rows(paths: list[Path], before: int) -> tuple[int, bool]:
-    """How many metrics rows the runs hold before step ``before``, and whether they are the
-    same in every run (wall times aside): a branch and its source must agree there."""
+def shared_rows(paths: list[Path], before: int, axis: str = "step") -> tuple[int, bool]:
+    """How many metrics rows the runs hold before ``before`` on ``axis``, and whether they are
+    the same in every run (wall times aside): a branch and its source must agree there."""
     tables = [
         [
             tuple(r.get(k, "") for k in COLUMNS if k != "wall_time")  # newer columns: empty
             for r in read_metrics(p if p.is_file() else p / METRICS_FILE)
-            if int(r["step"]) < before
+            if int(r[axis]) < before
         ]
         for p in paths
     ]
@@ -70,16 +81,22 @@ def main() -> None:
     parser.add_argument(
         "--to", dest="last", type=int, help="last policy step (runs of unequal length)"
     )
+    parser.add_argument(
+        "--env-steps",
+        action="store_true",
+        help="--from, --to and the rows count env steps (runs of different action repeats)",
+    )
     args = parser.parse_args()
+    axis, unit = ("env_steps", "env step") if args.env_steps else ("step", "policy step")
     names = [p.name for p in args.runs]
-    evals = [evaluations(p, args.first, last=args.last) for p in args.runs]
-    print("| policy step | " + " | ".join(names) + " |")
+    evals = [evaluations(p, args.first, last=args.last, axis=axis) for p in args.runs]
+    print(f"| {unit} | " + " | ".join(names) + " |")
     print("|---|" + "---|" * len(names))
     for step in sorted(set().union(*evals)):
         cells = [f"{e[step][0]:.1f} ({e[step][1]} falls)" if step in e else "-" for e in evals]
         print(f"| {step:,} | " + " | ".join(cells) + " |")
-    count, same = shared_rows(args.runs, args.first)
-    print(f"\nrows before step {args.first:,}: {count:,} in the first run, ", end="")
+    count, same = shared_rows(args.runs, args.first, axis)
+    print(f"\nrows before {unit} {args.first:,}: {count:,} in the first run, ", end="")
     print("the same in every run" if same else "NOT the same in every run")
     print()
     print(
@@ -88,14 +105,14 @@ def main() -> None:
     )
     print("|---|---|---|---|---|---|---|---|")
     for path, name, e in zip(args.runs, names, evals, strict=True):
-        count, mean_return, fell = training_episodes(path, args.first, args.last)
+        count, mean_return, fell = training_episodes(path, args.first, args.last, axis)
         if not e:  # no evaluation in the window: its training episodes still tell
             episodes = f"{count:,}, {mean_return:.1f}, {fell:.0%}" if count else "-"
             print(f"| {name} | 0 | - | - | - | - | - | {episodes} |")
             continue
         means = [m for m, _ in e.values()]
         best = max(e, key=lambda s: e[s][0])
-        tests = evaluations(path, args.first, "full_eval", args.last)
+        tests = evaluations(path, args.first, "full_eval", args.last, axis)
         test_text = ", ".join(f"{m:.1f} ({f} falls) at {s:,}" for s, (m, f) in tests.items())
         print(
             f"| {name} | {len(e)} | {statistics.mean(means):.1f} | "

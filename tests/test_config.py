@@ -44,6 +44,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-g99-probes-late": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-g99-utd2": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-wide": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-ar2": ("BipedalWalkerHardcore-v3", True, 2, 6, 4, -5.0, 5.0),
     "hardcore-lstm12": HARDCORE_H4[:3] + (12,) + HARDCORE_H4[4:],
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
@@ -188,6 +189,42 @@ def test_hardcore_lstm12_is_its_seed_0_run_but_for_the_window_and_its_lstm():
     assert cvar.agent.encoder == "none"
     lstm.seed, a.history, a.encoder = 1, 4, "none"
     assert lstm == cvar  # encoder_hidden is 64 in both: it is read only with an encoder
+
+
+def test_hardcore_lrdecay_cvar25_ar2_is_its_seed_0_run_per_env_step_at_action_repeat_2():
+    """Session 40's run from scratch: hardcore-lrdecay-cvar25.yaml's seed-0 run with each action
+    held for 2 env steps instead of 3. What spans env steps keeps its span (the discount per env
+    step, the window, the n-step horizon within one env step, and every schedule at 1.5 times
+    the policy steps); what counts updates keeps its count; nothing else may differ."""
+    cvar, ar2 = (
+        resolve_config(CONFIGS / f"{n}.yaml")
+        for n in ("hardcore-lrdecay-cvar25", "hardcore-lrdecay-cvar25-ar2")
+    )
+    a, b, t, u = ar2.agent, cvar.agent, ar2.train, cvar.train
+    assert (ar2.seed, a.action_repeat, b.action_repeat) == (0, 2, 3)
+    assert a.gamma ** (1 / 2) == pytest.approx(b.gamma ** (1 / 3), abs=1e-5)
+    assert a.history * 2 == b.history * 3 == 12
+    assert abs(a.n_step * 2 - b.n_step * 3) == 1
+    policy_steps = {
+        "agent.lr_decay_start": (a.lr_decay_start, b.lr_decay_start),
+        "agent.lr_decay_end": (a.lr_decay_end, b.lr_decay_end),
+        "agent.actor_cvar_start": (a.actor_cvar_start, b.actor_cvar_start),
+        "train.total_steps": (t.total_steps, u.total_steps),
+        "train.warmup_steps": (t.warmup_steps, u.warmup_steps),
+        "train.buffer_size": (t.buffer_size, u.buffer_size),
+        "train.eval_every": (t.eval_every, u.eval_every),
+        "train.checkpoint_every": (t.checkpoint_every, u.checkpoint_every),
+    }
+    for key, (mine, theirs) in policy_steps.items():
+        assert mine * 2 == theirs * 3, key
+    ar2.seed = 1
+    a = ar2.agent
+    a.action_repeat, a.gamma, a.history, a.n_step = 3, b.gamma, b.history, b.n_step
+    a.lr_decay_start, a.lr_decay_end = b.lr_decay_start, b.lr_decay_end
+    a.actor_cvar_start = b.actor_cvar_start
+    for name in ("total_steps", "warmup_steps", "buffer_size", "eval_every", "checkpoint_every"):
+        setattr(ar2.train, name, getattr(u, name))
+    assert ar2 == cvar
 
 
 RESTART_KEYS = tuple(
