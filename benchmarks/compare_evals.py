@@ -5,7 +5,7 @@
     python benchmarks/compare_evals.py docs/runs/hardcore-lrdecay-seed0 \\
         docs/runs/hardcore-h8-curated-seed0 --to 300000     # two runs at equal steps
     python benchmarks/compare_evals.py docs/runs/hardcore-lrdecay-cvar25-seed0 \\
-        docs/runs/hardcore-lrdecay-cvar25-ar2-seed0 --env-steps --to 3000000
+        runs/hardcore/lrdecay-cvar25-ar2-seed0 --env-steps --to 3000000
 
 With ``--env-steps`` the window and the rows count env steps instead of policy steps: runs with
 different action repeats compare at equal experience.
