@@ -32,6 +32,11 @@ COMMITTED = {
         0,
         "docs/runs/hardcore-lstm12-seed0/metrics.csv",
     ),
+    "hardcore-lrdecay-cvar25-ar2-seed0.pt": (
+        "hardcore-lrdecay-cvar25-ar2.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-ar2-seed0/metrics.csv",
+    ),
 }
 
 
