@@ -53,6 +53,17 @@ class ReplayBuffer:
         idx = rng.integers(0, self.size, size=batch_size)
         return {name: getattr(self, name)[idx] for name in self.fields}
 
+    def sample_recent(
+        self, batch_size: int, window: int, rng: np.random.Generator
+    ) -> dict[str, np.ndarray]:
+        """Uniform sample with replacement from the ``window`` newest transitions (ERE,
+        :mod:`.recency`): j ~ U{0 .. window - 1}, slot (pos - 1 - j) mod capacity."""
+        if not 1 <= window <= self.size:
+            raise ValueError(f"window {window} is not in [1, {self.size}] (the stored transitions)")
+        age = rng.integers(0, window, size=batch_size)  # (B,): 0 is the newest transition
+        idx = (self.pos - 1 - age) % self.capacity
+        return {name: getattr(self, name)[idx] for name in self.fields}
+
     def state_dict(self) -> dict:
         """The filled slots in storage order plus the write position.
 

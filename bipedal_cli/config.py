@@ -149,6 +149,15 @@ class TrainConfig:
     or its env return is below this (FORK: 250); the others are dropped. None: every episode."""
     replay_curation_start: int = 0
     """Policy step from which episodes (those that start there or later) are curated."""
+    replay_recency: float | None = None
+    """eta_0 in (0, 1): Emphasizing Recent Experience (ERE, the paper's future work): update k
+    of every 1000 draws from the newest max(N eta^k, ``replay_recent_min``) of the N stored
+    transitions (:mod:`~bipedal_cli.recency`; Wang and Ross use 0.996). null: uniform replay."""
+    replay_recency_end: int | None = None
+    """Policy step where eta reaches 1 (uniform replay), linearly from eta_0 at step 0, as ERE
+    anneals it over training. null: eta_0 throughout."""
+    replay_recent_min: int = 5000
+    """c_min: the fewest newest transitions an ERE update draws from (Wang and Ross: 5000)."""
     keep_policies: bool = False
     """Also save the policy of every periodic evaluation, ``policies/step-<N>.pt`` (about 1.4 MB
     each with Hardcore's networks), to choose among them afterwards on seeds that did not pick

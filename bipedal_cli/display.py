@@ -86,19 +86,7 @@ class TrainingDisplay:
             "learning rate",
             _num(s.get("lr"), "{:.2e}"),
         )
-        extra = []
-        if s.get("replay_kept") is not None:  # train.replay_keep_below: FORK's curation
-            extra += ["replay kept", _num(s["replay_kept"], "{:.0%}")]
-        if s.get("fall_penalty") is not None:  # train.fall_penalty_final: a ramp
-            extra += ["fall penalty", _num(s["fall_penalty"], "{:.1f}")]
-        if s.get("actor_cvar") is not None:  # agent.actor_cvar: the risk-averse actor
-            extra += ["actor objective", f"CVaR {s['actor_cvar']:g}"]
-        if s.get("batch_size") is not None:  # agent.batch_size_final: a larger batch later
-            extra += ["batch", f"{s['batch_size']:,}"]
-        if s.get("updates_per_step") is not None:  # train.updates_per_step_final
-            extra += ["updates/step", f"{s['updates_per_step']}"]
-        if s.get("falls_remembered") is not None:  # train.fall_restart: restarts near falls
-            extra += ["falls remembered", f"{s['falls_remembered']:,}"]
+        extra = [text for pair in scheduled_values(s) for text in pair]
         for first in range(0, len(extra), 8):  # four label-value pairs a row
             table.add_row(*extra[first : first + 8])
         return table
@@ -122,28 +110,7 @@ class TrainingDisplay:
                 f"steps/s {_num(s.get('steps_per_s'))}  return (avg 10) "
                 f"{_num(s.get('avg_return'))}  falls {_num(s.get('fall_rate'), '{:.0%}')}  "
                 f"last eval {_num(s.get('last_eval'))}  alpha {_num(s.get('alpha'), '{:.4f}')}"
-                + (
-                    f"  replay kept {s['replay_kept']:.0%}"
-                    if s.get("replay_kept") is not None
-                    else ""
-                )
-                + (
-                    f"  fall penalty {s['fall_penalty']:.1f}"
-                    if s.get("fall_penalty") is not None
-                    else ""
-                )
-                + (f"  actor CVaR {s['actor_cvar']:g}" if s.get("actor_cvar") else "")
-                + (f"  batch {s['batch_size']}" if s.get("batch_size") else "")
-                + (
-                    f"  updates/step {s['updates_per_step']}"
-                    if s.get("updates_per_step") is not None
-                    else ""
-                )
-                + (
-                    f"  falls remembered {s['falls_remembered']}"
-                    if s.get("falls_remembered") is not None
-                    else ""
-                ),
+                + "".join(f"  {label} {value}" for label, value in scheduled_values(s)),
                 soft_wrap=True,
             )
 
@@ -152,6 +119,26 @@ class TrainingDisplay:
 
     def close(self) -> None:
         self.progress.stop()
+
+
+def scheduled_values(s: dict) -> list[tuple[str, str]]:
+    """(label, value) of each config feature a snapshot shows only when it is on."""
+    pairs = []
+    if s.get("replay_kept") is not None:  # train.replay_keep_below: FORK's curation
+        pairs.append(("replay kept", _num(s["replay_kept"], "{:.0%}")))
+    if s.get("fall_penalty") is not None:  # train.fall_penalty_final: a ramp
+        pairs.append(("fall penalty", _num(s["fall_penalty"], "{:.1f}")))
+    if s.get("actor_cvar") is not None:  # agent.actor_cvar: the risk-averse actor
+        pairs.append(("actor objective", f"CVaR {s['actor_cvar']:g}"))
+    if s.get("batch_size") is not None:  # agent.batch_size_final: a larger batch later
+        pairs.append(("batch", f"{s['batch_size']:,}"))
+    if s.get("updates_per_step") is not None:  # train.updates_per_step_final
+        pairs.append(("updates/step", f"{s['updates_per_step']}"))
+    if s.get("replay_recency") is not None:  # train.replay_recency: ERE
+        pairs.append(("recent replay", f"eta {s['replay_recency']:.5f}"))
+    if s.get("falls_remembered") is not None:  # train.fall_restart: restarts near falls
+        pairs.append(("falls remembered", f"{s['falls_remembered']:,}"))
+    return pairs
 
 
 def eval_table(summary: dict, title: str) -> Table:

@@ -10,6 +10,7 @@ import numpy as np
 
 from .episodes import curation_keeps, curation_on
 from .fall_restarts import restarts_on
+from .recency import recency_at
 from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at, updates_at
 
 
@@ -73,6 +74,8 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         "updates_per_step": (
             updates_at(trainer.step, t) if t.updates_per_step_final is not None else None
         ),
+        # train.replay_recency: ERE's eta at this step (1: uniform replay again)
+        "replay_recency": recency_at(trainer.step, t),
         # train.fall_restart: the falls that episodes may restart near
         "falls_remembered": len(trainer.fall_memory) if restarts_on(t, trainer.step) else None,
         **trainer.last_metrics,

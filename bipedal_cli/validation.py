@@ -124,6 +124,17 @@ def validate(cfg: Any, source: str) -> None:
         ),
         (t.replay_curation_start >= 0, "train.replay_curation_start", "a non-negative integer"),
         (
+            t.replay_recency is None or 0.0 < t.replay_recency < 1.0,
+            "train.replay_recency",
+            "null or a number in (0, 1) (ERE's eta_0, for example 0.996)",
+        ),
+        (
+            t.replay_recency_end is None or t.replay_recency_end >= 1,
+            "train.replay_recency_end",
+            "null or a positive policy step (where eta reaches 1)",
+        ),
+        (t.replay_recent_min >= 1, "train.replay_recent_min", "a positive integer"),
+        (
             a.lr_final is None or a.lr_decay_end > a.lr_decay_start,
             "agent.lr_decay_end",
             "a step after agent.lr_decay_start (with agent.lr_final set)",

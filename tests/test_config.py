@@ -15,6 +15,7 @@ from bipedal_cli.fall_restarts import draws_probe, restarts_on
 from bipedal_cli.schedule import batch_size_at, updates_at
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
+ROOT = CONFIGS.parent
 
 
 def test_default_yaml_equals_the_dataclass_defaults():
@@ -45,6 +46,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-g99-utd2": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-wide": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-ar2": ("BipedalWalkerHardcore-v3", True, 2, 6, 4, -5.0, 5.0),
+    "hardcore-lrdecay-cvar25-ere": HARDCORE_H4,
     "hardcore-lstm12": HARDCORE_H4[:3] + (12,) + HARDCORE_H4[4:],
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
@@ -216,6 +218,22 @@ def test_hardcore_lrdecay_cvar25_ar2_is_its_seed_0_run_per_env_step_at_action_re
     ar2.seed = 1
     a.action_repeat, a.gamma, a.history, a.n_step = 3, b.gamma, b.history, b.n_step
     assert ar2 == cvar
+
+
+def test_hardcore_lrdecay_cvar25_ere_is_its_seed_0_run_with_recent_experience_emphasized():
+    """Session 45's run from scratch: the seed-0 run of hardcore-lrdecay-cvar25.yaml (the shipped
+    policy's, its config in docs/runs) with ERE, eta 0.996 annealed to 1 at the decay's end;
+    nothing else may differ."""
+    from bipedal_cli.recency import recency_at
+
+    seed0 = resolve_config(ROOT / "docs/runs/hardcore-lrdecay-cvar25-seed0/config.yaml")
+    ere = resolve_config(CONFIGS / "hardcore-lrdecay-cvar25-ere.yaml")
+    t = ere.train
+    assert (t.replay_recency, t.replay_recency_end, t.replay_recent_min) == (0.996, 1_700_000, 5000)
+    assert t.replay_recency_end == ere.agent.lr_decay_end
+    assert recency_at(1_700_000, t) == 1.0 and recency_at(0, seed0.train) is None
+    t.replay_recency, t.replay_recency_end = None, None
+    assert ere == seed0
 
 
 RESTART_KEYS = tuple(
