@@ -71,6 +71,17 @@ DEFERRED = (
         lambda c: c.train.fall_restart > 0,
         lambda c: c.train.fall_restart_start,
     ),
+    (
+        (
+            "train.obstacle_stump",
+            "train.obstacle_stairs",
+            "train.obstacle_pit",
+            "train.obstacle_mix_start",
+        ),
+        "train.obstacle_mix_start",
+        lambda c: len({c.train.obstacle_stump, c.train.obstacle_stairs, c.train.obstacle_pit}) > 1,
+        lambda c: c.train.obstacle_mix_start,
+    ),
     # the anchor pulls nothing while the actor waits: it is still the anchor itself
     (
         ("agent.actor_anchor", "agent.actor_anchor_kl"),
@@ -96,8 +107,8 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
     run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
     threads, budget and kept policies (they do not change the bits), and features that start
     at a policy step (DEFERRED: learning-rate decay, replay curation, fall-penalty ramp,
-    risk-averse actor, larger batch, restarts near falls) as long as they change nothing before
-    ``step``. One line naming the first key that breaks this."""
+    risk-averse actor, larger batch, restarts near falls, obstacle mix) as long as they change
+    nothing before ``step``. One line naming the first key that breaks this."""
     old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
     deferred_keys: set[str] = set()
     for keys, start_key, is_on, start in DEFERRED:
@@ -118,5 +129,5 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
             "train.refill_steps and "
             "features that start at or after the branch point (learning-rate decay, replay "
             "curation, fall-penalty ramp, risk-averse actor, larger batch, restarts near falls, "
-            "actor anchor)"
+            "actor anchor, obstacle mix)"
         )

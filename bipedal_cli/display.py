@@ -136,6 +136,9 @@ def scheduled_values(s: dict) -> list[tuple[str, str]]:
         pairs.append(("updates/step", f"{s['updates_per_step']}"))
     if s.get("replay_recency") is not None:  # train.replay_recency: ERE
         pairs.append(("recent replay", f"eta {s['replay_recency']:.5f}"))
+    if s.get("obstacle_mix") is not None:  # train.obstacle_*: more of some obstacles
+        shares = zip(("stump", "stairs", "pit"), s["obstacle_mix"], strict=True)
+        pairs.append(("obstacles", " ".join(f"{k} {p:.0%}" for k, p in shares)))
     if s.get("falls_remembered") is not None:  # train.fall_restart: restarts near falls
         pairs.append(("falls remembered", f"{s['falls_remembered']:,}"))
     return pairs

@@ -24,6 +24,7 @@ import gymnasium as gym
 import numpy as np
 
 from .env_ids import canonical_env_id
+from .obstacle_mix import ObstacleMix
 
 FALL_REWARD = -100.0  # BipedalWalker's reward on the step where the hull touches the ground
 
@@ -117,17 +118,21 @@ def make_env(
     fall_penalty: float | None = None,
     reward_scale: float = 1.0,
     on_env_step: Callable[[float], None] | None = None,
+    obstacle_weights: tuple[float, float, float] | None = None,
 ) -> gym.Env:
     """A Gymnasium env with its standard TimeLimit and the wrappers described above.
 
     ``render=True`` uses ``render_mode="rgb_array"``: frames come back as arrays, no window and
     no display are needed. ``on_env_step(env_reward)`` is called after every env step (also
-    inside an action repeat).
+    inside an action repeat). ``obstacle_weights`` (stump, stairs, pit; training only) builds
+    Hardcore's courses with that mix (:class:`~bipedal_cli.obstacle_mix.ObstacleMix`, innermost).
     """
     env_id = canonical_env_id(env_id)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         env = gym.make(env_id, render_mode="rgb_array" if render else None)
+    if obstacle_weights is not None:
+        env = ObstacleMix(env, obstacle_weights)
     env = RewardShaping(env, fall_penalty, reward_scale)
     if action_repeat > 1 or on_env_step is not None:
         env = ActionRepeat(env, action_repeat, on_env_step)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .episodes import FinishedEpisode, curation_on
+from .episodes import FinishedEpisode, curation_on, obstacle_mix_on
 from .fall_restarts import draws_probe, remembers_fall, restarts_on
 from .metrics import MetricsWriter
 from .schedule import fall_penalty_at
@@ -23,7 +23,7 @@ def start_episode(trainer: Any) -> None:
     seed, prefix = restart or (int(trainer.rng.integers(2**31 - 1)), None)
     probe = restart is None and draws_probe(trainer.rng, t, step)
     curated, penalty = curation_on(t, step), fall_penalty_at(step, t)
-    trainer.runner.start(seed, curated, penalty, prefix, probe)
+    trainer.runner.start(seed, curated, penalty, prefix, probe, obstacle_mix_on(t, step))
 
 
 def record_episode(trainer: Any, ep: FinishedEpisode, metrics: MetricsWriter) -> None:

@@ -16,6 +16,7 @@ from .buffer import ReplayBuffer
 from .config import Config, TrainConfig
 from .envs import make_env
 from .nstep import NStepAccumulator
+from .obstacle_mix import mix_is_uniform
 
 
 def curation_on(train: TrainConfig, step: int) -> bool:
@@ -27,6 +28,16 @@ def curation_keeps(fell: bool, env_return: float, keep_below: float) -> bool:
     """FORK's rule: a curated episode enters the replay buffer only if it fell or its env return
     is below ``keep_below``."""
     return fell or env_return < keep_below
+
+
+def obstacle_mix_on(train: TrainConfig, step: int) -> bool:
+    """Whether an episode starting at ``step`` trains on a course with the obstacle mix
+    (``train.obstacle_stump``, ``_stairs``, ``_pit`` unequal; :mod:`.obstacle_mix`)."""
+    return not mix_is_uniform(obstacle_weights(train)) and step >= train.obstacle_mix_start
+
+
+def obstacle_weights(train: TrainConfig) -> tuple[float, float, float]:
+    return (train.obstacle_stump, train.obstacle_stairs, train.obstacle_pit)
 
 
 @dataclass
@@ -43,6 +54,7 @@ class EpisodeState:
     restart_at: int | None = None  # a restart near a fall: the actions replayed, not stored
     restart_env_steps: int = 0  # and their env steps
     probe: bool = False  # played by the deterministic policy (train.fall_restart_probe)
+    obstacle_mix: bool = False  # its course has train.obstacle_*'s mix of obstacles
 
 
 @dataclass
@@ -82,6 +94,7 @@ class EpisodeRunner:
             history=a.history,
             fall_penalty=self.episode.fall_penalty,
             reward_scale=t.reward_scale,
+            obstacle_weights=obstacle_weights(t) if self.episode.obstacle_mix else None,
         )
 
     def _fresh_env(self) -> None:
@@ -95,15 +108,21 @@ class EpisodeRunner:
         fall_penalty: float | None,
         prefix: np.ndarray | None = None,
         probe: bool = False,
+        obstacle_mix: bool = False,
     ) -> None:
         """A new episode on a new env reset with ``seed``; ``curated`` and ``fall_penalty`` hold
         to its end (:func:`curation_on` and :func:`~bipedal_cli.schedule.fall_penalty_at` at
         the step it starts). With ``prefix`` (a restart near a fall,
         :mod:`bipedal_cli.fall_restarts`) those actions are replayed first and nothing of them
         is stored: the learner takes over after them. A ``probe`` is played by the
-        deterministic policy (the trainer reads it from :attr:`episode`)."""
+        deterministic policy (the trainer reads it from :attr:`episode`); ``obstacle_mix``
+        builds its course with the config's mix of obstacles (:func:`obstacle_mix_on`)."""
         self.episode = EpisodeState(
-            seed=seed, curated=curated, fall_penalty=fall_penalty, probe=probe
+            seed=seed,
+            curated=curated,
+            fall_penalty=fall_penalty,
+            probe=probe,
+            obstacle_mix=obstacle_mix,
         )
         self._fresh_env()
         obs, _ = self.env.reset(seed=seed)
@@ -178,13 +197,14 @@ class EpisodeRunner:
         fall_penalty: float | None,
         restart_at: int | None = None,
         probe: bool = False,
+        obstacle_mix: bool = False,
     ) -> bool:
         """Rebuild an interrupted episode (its transitions are in the buffer already, or, when
         curated, staged again; a restart's first ``restart_at`` actions are replayed as its
         start replayed them); False when the rebuilt observation differs from
         ``expected_obs``."""
         prefix = None if restart_at is None else actions[:restart_at]
-        self.start(seed, curated, fall_penalty, prefix, probe)
+        self.start(seed, curated, fall_penalty, prefix, probe, obstacle_mix)
         for action in actions[restart_at or 0 :]:
             next_obs, reward, terminated, truncated, info = self.env.step(action)
             truncated = self._cut(truncated)
@@ -208,5 +228,6 @@ class EpisodeRunner:
             "fall_penalty": e.fall_penalty,
             "restart_at": e.restart_at,
             "probe": e.probe,
+            "obstacle_mix": e.obstacle_mix,
             "obs": None if self.obs is None else torch.from_numpy(self.obs.copy()),
         }

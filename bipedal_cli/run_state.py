@@ -120,6 +120,7 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
             None if penalty is None else float(penalty),
             ep.get("restart_at"),
             bool(ep.get("probe")),  # since 2026-12-03: train.fall_restart_probe
+            bool(ep.get("obstacle_mix")),  # since 2026-12-06: train.obstacle_*
         )
         if not rebuilt:
             trainer.reporter.log(

@@ -125,8 +125,9 @@ def check_checkpoint(data: dict, where: str, train_state: bool) -> Config:
         type(restart_at) is int and 0 <= restart_at <= actions.shape[0]
     ):
         raise _fail(where, "episode.restart_at", f"should be null or in [0, {actions.shape[0]}]")
-    if type(episode.get("probe", False)) is not bool:  # since 2026-12-03
-        raise _fail(where, "episode.probe", "should be true or false")
+    for flag in ("probe", "obstacle_mix"):  # since 2026-12-03 and 2026-12-06
+        if type(episode.get(flag, False)) is not bool:
+            raise _fail(where, f"episode.{flag}", "should be true or false")
     _check_fall_memory(data.get("fall_memory") or [], act_dim, where)
     if data.get("machine") is not None:  # since 2026-12-05: where it was saved
         _get(data, "machine", str, where)

@@ -8,8 +8,9 @@ from typing import Any
 
 import numpy as np
 
-from .episodes import curation_keeps, curation_on
+from .episodes import curation_keeps, curation_on, obstacle_mix_on, obstacle_weights
 from .fall_restarts import restarts_on
+from .obstacle_mix import kind_probabilities
 from .recency import recency_at
 from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at, updates_at
 
@@ -76,6 +77,10 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         ),
         # train.replay_recency: ERE's eta at this step (1: uniform replay again)
         "replay_recency": recency_at(trainer.step, t),
+        # train.obstacle_*: the share of each obstacle kind on the learner's new courses
+        "obstacle_mix": (
+            kind_probabilities(obstacle_weights(t)) if obstacle_mix_on(t, trainer.step) else None
+        ),
         # train.fall_restart: the falls that episodes may restart near
         "falls_remembered": len(trainer.fall_memory) if restarts_on(t, trainer.step) else None,
         **trainer.last_metrics,

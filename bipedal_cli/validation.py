@@ -134,6 +134,20 @@ def validate(cfg: Any, source: str) -> None:
             "null or a positive policy step (where eta reaches 1)",
         ),
         (t.replay_recent_min >= 1, "train.replay_recent_min", "a positive integer"),
+        (t.obstacle_stump >= 0, "train.obstacle_stump", "a non-negative weight"),
+        (t.obstacle_stairs >= 0, "train.obstacle_stairs", "a non-negative weight"),
+        (t.obstacle_pit >= 0, "train.obstacle_pit", "a non-negative weight"),
+        (
+            t.obstacle_stump + t.obstacle_stairs + t.obstacle_pit > 0,
+            "train.obstacle_pit",
+            "weights of stump, stairs and pit with a positive sum",
+        ),
+        (t.obstacle_mix_start >= 0, "train.obstacle_mix_start", "a non-negative step"),
+        (
+            len({t.obstacle_stump, t.obstacle_stairs, t.obstacle_pit}) == 1 or t.fall_restart == 0,
+            "train.fall_restart",
+            "0 with an obstacle mix (a restart rebuilds a course from its seed alone)",
+        ),
         (
             a.lr_final is None or a.lr_decay_end > a.lr_decay_start,
             "agent.lr_decay_end",

@@ -47,6 +47,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-wide": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-ar2": ("BipedalWalkerHardcore-v3", True, 2, 6, 4, -5.0, 5.0),
     "hardcore-lrdecay-cvar25-ere": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-stumps": HARDCORE_H4,
     "hardcore-lstm12": HARDCORE_H4[:3] + (12,) + HARDCORE_H4[4:],
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
@@ -234,6 +235,20 @@ def test_hardcore_lrdecay_cvar25_ere_is_its_seed_0_run_with_recent_experience_em
     assert recency_at(1_700_000, t) == 1.0 and recency_at(0, seed0.train) is None
     t.replay_recency, t.replay_recency_end = None, None
     assert ere == seed0
+
+
+def test_hardcore_lrdecay_cvar25_stumps_is_its_seed_0_run_with_twice_the_stumps():
+    """Prepared in session 45: the seed-0 run of hardcore-lrdecay-cvar25.yaml with stumps
+    weighted 2 against 1 for stairs and pits from the first episode; nothing else may differ."""
+    from bipedal_cli.episodes import obstacle_mix_on
+
+    seed0 = resolve_config(ROOT / "docs/runs/hardcore-lrdecay-cvar25-seed0/config.yaml")
+    stumps = resolve_config(CONFIGS / "hardcore-lrdecay-cvar25-stumps.yaml")
+    t = stumps.train
+    assert (t.obstacle_stump, t.obstacle_stairs, t.obstacle_pit) == (2.0, 1.0, 1.0)
+    assert obstacle_mix_on(t, 0) and not obstacle_mix_on(seed0.train, 10**7)
+    t.obstacle_stump = 1.0
+    assert stumps == seed0
 
 
 RESTART_KEYS = tuple(
