@@ -49,6 +49,18 @@ def wide_console(monkeypatch):
     monkeypatch.setenv("COLUMNS", "200")
 
 
+def stats_text(snapshot: dict) -> str:
+    """The training display's statistics table for ``snapshot``, as the terminal shows it."""
+    from rich.console import Console
+
+    from bipedal_cli.display import TrainingDisplay
+
+    display = TrainingDisplay(Console(width=200, record=True))
+    display.snapshot = snapshot
+    display.console.print(display.stats_table())
+    return display.console.export_text()
+
+
 BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
 
 

@@ -13,7 +13,7 @@ from bipedal_cli.resume import branch, resume
 from bipedal_cli.schedule import actor_lowest_atoms
 from bipedal_cli.train import Trainer, train
 
-from .conftest import tiny_dict
+from .conftest import stats_text, tiny_dict
 from .reference import ref_actor_cvar_loss, ref_actor_loss
 from .test_train import assert_states_equal
 
@@ -114,14 +114,8 @@ def test_a_branch_may_switch_it_on_at_its_step_but_not_before(tmp_path):
 
 
 def test_the_display_shows_the_objective_once_it_is_on(tmp_path):
-    from rich.console import Console
-
-    from bipedal_cli.display import TrainingDisplay
 
     trainer = Trainer(config_from_dict(cvar_dict()), tmp_path / "run")
     assert trainer.snapshot(0.0)["actor_cvar"] is None  # before its step
     trainer.step = 300
-    display = TrainingDisplay(Console(width=200, record=True))
-    display.snapshot = trainer.snapshot(0.0)
-    display.console.print(display.stats_table())
-    assert "actor objective  CVaR 0.4 " in display.console.export_text()
+    assert "actor objective  CVaR 0.4 " in stats_text(trainer.snapshot(0.0))

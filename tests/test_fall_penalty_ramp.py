@@ -12,7 +12,7 @@ from bipedal_cli.resume import branch, resume
 from bipedal_cli.schedule import fall_penalty_at
 from bipedal_cli.train import train
 
-from .conftest import tiny_dict
+from .conftest import stats_text, tiny_dict
 from .test_hardcore_features import SHAPING, featured
 from .test_train import assert_states_equal
 
@@ -120,17 +120,11 @@ def test_a_branch_may_start_the_ramp_at_its_step_but_not_before(tmp_path):
 
 
 def test_the_display_shows_the_penalty_of_the_episode_in_progress(tmp_path):
-    from rich.console import Console
-
-    from bipedal_cli.display import TrainingDisplay
     from bipedal_cli.train import Trainer
 
     trainer = Trainer(config_from_dict(ramped()), tmp_path / "run")
     trainer.step = 125
     trainer.start_episode()
-    display = TrainingDisplay(Console(width=200, record=True))
-    display.snapshot = trainer.snapshot(0.0)
-    display.console.print(display.stats_table())
-    assert "fall penalty  -23.5" in display.console.export_text()
+    assert "fall penalty  -23.5" in stats_text(trainer.snapshot(0.0))
     plain = Trainer(config_from_dict(featured()), tmp_path / "plain")
     assert plain.snapshot(0.0)["fall_penalty"] is None  # no ramp: the line stays as it was

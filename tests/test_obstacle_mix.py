@@ -26,7 +26,7 @@ from bipedal_cli.resume import branch, resume
 from bipedal_cli.terrain import course_obstacles
 from bipedal_cli.train import Trainer, train
 
-from .conftest import tiny_dict
+from .conftest import stats_text, tiny_dict
 from .test_train import assert_states_equal
 
 MIX = {"obstacle_stump": 2.0, "obstacle_mix_start": 40}
@@ -165,17 +165,11 @@ def test_config_errors_name_the_key(keys, key):
 
 
 def test_the_display_shows_the_shares(tmp_path):
-    from rich.console import Console
-
-    from bipedal_cli.display import TrainingDisplay
 
     trainer = Trainer(config_from_dict(mix_dict(400)), tmp_path / "run")
     assert trainer.snapshot(0.0)["obstacle_mix"] is None  # before its start
     trainer.step = 40
-    display = TrainingDisplay(Console(width=200, record=True))
-    display.snapshot = trainer.snapshot(0.0)
-    display.console.print(display.stats_table())
-    assert "obstacles  stump 50% stairs 25% pit 25%" in display.console.export_text()
+    assert "obstacles  stump 50% stairs 25% pit 25%" in stats_text(trainer.snapshot(0.0))
 
 
 def test_a_damaged_mix_flag_in_a_checkpoint_is_a_one_line_error(tmp_path):

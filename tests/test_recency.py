@@ -17,7 +17,7 @@ from bipedal_cli.recency import SEQUENCE, recency_at, recent_window
 from bipedal_cli.resume import branch, resume
 from bipedal_cli.train import Trainer, train
 
-from .conftest import tiny_dict
+from .conftest import stats_text, tiny_dict
 from .test_train import assert_states_equal
 
 ERE = {"replay_recency": 0.99, "replay_recency_end": 600, "replay_recent_min": 20}
@@ -148,17 +148,11 @@ def test_config_errors_name_the_key(keys, key):
 
 
 def test_the_display_shows_eta(tmp_path):
-    from rich.console import Console
-
-    from bipedal_cli.display import TrainingDisplay
 
     trainer = Trainer(ere_config(400), tmp_path / "run")
     trainer.step = 300
     assert trainer.snapshot(0.0)["replay_recency"] == pytest.approx(0.995)
-    display = TrainingDisplay(Console(width=200, record=True))
-    display.snapshot = trainer.snapshot(0.0)
-    display.console.print(display.stats_table())
-    assert "recent replay  eta 0.99500" in display.console.export_text()
+    assert "recent replay  eta 0.99500" in stats_text(trainer.snapshot(0.0))
     assert (
         Trainer(config_from_dict(tiny_dict()), tmp_path / "p").snapshot(0.0)["replay_recency"]
         is None

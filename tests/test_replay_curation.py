@@ -11,6 +11,7 @@ from bipedal_cli.episodes import EpisodeRunner
 from bipedal_cli.resume import resume
 from bipedal_cli.train import train
 
+from .conftest import stats_text
 from .test_hardcore_features import featured
 from .test_train import assert_states_equal
 
@@ -117,22 +118,14 @@ def test_resume_is_exact_with_curation_and_it_changes_the_run(tmp_path):
 
 
 def test_the_display_shows_the_share_of_recent_episodes_the_curation_kept():
-    from rich.console import Console
-
-    from bipedal_cli.display import TrainingDisplay
     from bipedal_cli.snapshot import replay_kept_share
 
     returns, falls = [300.0, 100.0, 280.0, 290.0], [False, False, True, False]
     assert replay_kept_share(returns, falls, 250.0) == 0.5  # the low one and the fall
     assert replay_kept_share(returns, falls, None) is None
     assert replay_kept_share([], [], 250.0) is None
-    display = TrainingDisplay(Console(width=200, record=True))
-    display.snapshot = {"step": 10, "replay_kept": 0.5}
-    display.console.print(display.stats_table())
-    assert "replay kept  50%" in display.console.export_text()
-    display.snapshot = {"step": 10, "replay_kept": None}
-    display.console.print(display.stats_table())
-    assert "replay kept" not in display.console.export_text()
+    assert "replay kept  50%" in stats_text({"step": 10, "replay_kept": 0.5})
+    assert "replay kept" not in stats_text({"step": 10, "replay_kept": None})
 
 
 def test_the_snapshot_reports_the_kept_share_once_curation_has_started():

@@ -12,7 +12,7 @@ from bipedal_cli.resume import branch, resume
 from bipedal_cli.schedule import batch_size_at, updates_at
 from bipedal_cli.train import Trainer, train
 
-from .conftest import tiny_dict
+from .conftest import stats_text, tiny_dict
 from .test_train import assert_states_equal
 
 # name: (config section, its keys switched on at policy step 250)
@@ -134,16 +134,10 @@ def test_a_branch_may_switch_it_on_at_its_step_but_not_before(tmp_path, name):
     [("batch", "batch_size", "batch  48 "), ("updates", "updates_per_step", "updates/step  2 ")],
 )
 def test_the_display_shows_the_switched_value(tmp_path, name, key, shown):
-    from rich.console import Console
-
-    from bipedal_cli.display import TrainingDisplay
 
     trainer = Trainer(config_from_dict(switched_dict(name, 400)), tmp_path / "run")
     before = trainer.cfg.agent.batch_size if name == "batch" else trainer.cfg.train.updates_per_step
     assert trainer.snapshot(0.0)[key] == before
     trainer.step = 251
-    display = TrainingDisplay(Console(width=200, record=True))
-    display.snapshot = trainer.snapshot(0.0)
-    display.console.print(display.stats_table())
-    assert shown in display.console.export_text()
+    assert shown in stats_text(trainer.snapshot(0.0))
     assert Trainer(config_from_dict(tiny_dict()), tmp_path / "p").snapshot(0.0)[key] is None
