@@ -37,6 +37,11 @@ COMMITTED = {
         0,
         "docs/runs/hardcore-lrdecay-cvar25-ar2-seed0/metrics.csv",
     ),
+    "hardcore-lrdecay-cvar25-ere-seed0.pt": (
+        "hardcore-lrdecay-cvar25-ere.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-ere-seed0/metrics.csv",
+    ),
 }
 
 
