@@ -79,7 +79,7 @@ DEFERRED = (
             "train.obstacle_mix_start",
         ),
         "train.obstacle_mix_start",
-        lambda c: len({c.train.obstacle_stump, c.train.obstacle_stairs, c.train.obstacle_pit}) > 1,
+        lambda c: c.train.mixes_obstacles(),
         lambda c: c.train.obstacle_mix_start,
     ),
     # the anchor pulls nothing while the actor waits: it is still the anchor itself

@@ -16,7 +16,6 @@ from .buffer import ReplayBuffer
 from .config import Config, TrainConfig
 from .envs import make_env
 from .nstep import NStepAccumulator
-from .obstacle_mix import mix_is_uniform
 
 
 def curation_on(train: TrainConfig, step: int) -> bool:
@@ -33,11 +32,7 @@ def curation_keeps(fell: bool, env_return: float, keep_below: float) -> bool:
 def obstacle_mix_on(train: TrainConfig, step: int) -> bool:
     """Whether an episode starting at ``step`` trains on a course with the obstacle mix
     (``train.obstacle_stump``, ``_stairs``, ``_pit`` unequal; :mod:`.obstacle_mix`)."""
-    return not mix_is_uniform(obstacle_weights(train)) and step >= train.obstacle_mix_start
-
-
-def obstacle_weights(train: TrainConfig) -> tuple[float, float, float]:
-    return (train.obstacle_stump, train.obstacle_stairs, train.obstacle_pit)
+    return train.mixes_obstacles() and step >= train.obstacle_mix_start
 
 
 @dataclass
@@ -94,7 +89,7 @@ class EpisodeRunner:
             history=a.history,
             fall_penalty=self.episode.fall_penalty,
             reward_scale=t.reward_scale,
-            obstacle_weights=obstacle_weights(t) if self.episode.obstacle_mix else None,
+            obstacle_weights=t.obstacle_weights() if self.episode.obstacle_mix else None,
         )
 
     def _fresh_env(self) -> None:

@@ -66,8 +66,3 @@ class ObstacleMix(gym.Wrapper):
             rng, _ = seeding.np_random(seed)
             base.np_random = WeightedKindGenerator(rng, self.probabilities)
         return self.env.reset(seed=None, options=options)
-
-
-def mix_is_uniform(weights: Sequence[float]) -> bool:
-    """Equal weights are the unmodified env: no wrapper at all, so the bits stay the env's."""
-    return len(set(weights)) == 1

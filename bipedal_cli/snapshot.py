@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from .episodes import curation_keeps, curation_on, obstacle_mix_on, obstacle_weights
+from .episodes import curation_keeps, curation_on, obstacle_mix_on
 from .fall_restarts import restarts_on
 from .obstacle_mix import kind_probabilities
 from .recency import recency_at
@@ -79,7 +79,7 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         "replay_recency": recency_at(trainer.step, t),
         # train.obstacle_*: the share of each obstacle kind on the learner's new courses
         "obstacle_mix": (
-            kind_probabilities(obstacle_weights(t)) if obstacle_mix_on(t, trainer.step) else None
+            kind_probabilities(t.obstacle_weights()) if obstacle_mix_on(t, trainer.step) else None
         ),
         # train.fall_restart: the falls that episodes may restart near
         "falls_remembered": len(trainer.fall_memory) if restarts_on(t, trainer.step) else None,

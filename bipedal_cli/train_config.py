@@ -126,3 +126,12 @@ class TrainConfig:
     """A run continued from a ``restart.pt`` (no replay buffer: ``bipedal resume FILE --into
     DIR``) first acts this many policy steps with its own actor, without updates, to refill the
     buffer it lost; then learning goes on. Changes nothing in a run that is not restarted."""
+
+    def obstacle_weights(self) -> tuple[float, float, float]:
+        """The weights of stump, stairs and pit (``obstacle_stump``, ``_stairs``, ``_pit``)."""
+        return (self.obstacle_stump, self.obstacle_stairs, self.obstacle_pit)
+
+    def mixes_obstacles(self) -> bool:
+        """Unequal weights: courses with a mix of obstacles from ``obstacle_mix_start`` (equal
+        weights are the unmodified env: no wrapper at all, so the bits stay the env's)."""
+        return len(set(self.obstacle_weights())) > 1

@@ -144,7 +144,7 @@ def validate(cfg: Any, source: str) -> None:
         ),
         (t.obstacle_mix_start >= 0, "train.obstacle_mix_start", "a non-negative step"),
         (
-            len({t.obstacle_stump, t.obstacle_stairs, t.obstacle_pit}) == 1 or t.fall_restart == 0,
+            not t.mixes_obstacles() or t.fall_restart == 0,
             "train.fall_restart",
             "0 with an obstacle mix (a restart rebuilds a course from its seed alone)",
         ),
