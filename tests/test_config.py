@@ -47,6 +47,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-wide": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-ar2": ("BipedalWalkerHardcore-v3", True, 2, 6, 4, -5.0, 5.0),
     "hardcore-lrdecay-cvar25-ere": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-ere-stumps": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-stumps": HARDCORE_H4,
     "hardcore-lstm12": HARDCORE_H4[:3] + (12,) + HARDCORE_H4[4:],
     "hardcore-warm-anchor100": HARDCORE_H4,
@@ -249,6 +250,26 @@ def test_hardcore_lrdecay_cvar25_stumps_is_its_seed_0_run_with_twice_the_stumps(
     assert obstacle_mix_on(t, 0) and not obstacle_mix_on(seed0.train, 10**7)
     t.obstacle_stump = 1.0
     assert stumps == seed0
+
+
+def test_the_ere_stumps_config_is_the_ere_run_branched_at_1_1m_with_twice_the_stumps():
+    """Session 46's branch: the ERE run from its full state at 1.1M, with stumps weighted 2
+    against 1 from there. The branch check accepts it at 1.1M, not a step later, and nothing but
+    the obstacle weights differs."""
+    from bipedal_cli.branch_rules import check_branch_config
+    from bipedal_cli.episodes import obstacle_mix_on
+
+    ere, stumps = (
+        resolve_config(CONFIGS / f"hardcore-lrdecay-cvar25-{n}.yaml") for n in ("ere", "ere-stumps")
+    )
+    t = stumps.train
+    assert (t.obstacle_stump, t.obstacle_stairs, t.obstacle_pit) == (2.0, 1.0, 1.0)
+    assert not obstacle_mix_on(t, 1_099_999) and obstacle_mix_on(t, 1_100_000)
+    check_branch_config(ere, stumps, 1_100_000, "hardcore-lrdecay-cvar25-ere-stumps.yaml")
+    with pytest.raises(UserError, match="obstacle_mix_start"):
+        check_branch_config(ere, stumps, 1_100_001, "hardcore-lrdecay-cvar25-ere-stumps.yaml")
+    t.obstacle_stump, t.obstacle_mix_start = 1.0, TrainConfig().obstacle_mix_start
+    assert stumps == ere
 
 
 RESTART_KEYS = tuple(
