@@ -49,6 +49,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-ere": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-ere-stumps": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-stumps": HARDCORE_H4,
+    "hardcore-lrdecay-cvar10-ere": HARDCORE_H4,
     "hardcore-lstm12": HARDCORE_H4[:3] + (12,) + HARDCORE_H4[4:],
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
@@ -270,6 +271,23 @@ def test_the_ere_stumps_config_is_the_ere_run_branched_at_1_1m_with_twice_the_st
         check_branch_config(ere, stumps, 1_100_001, "hardcore-lrdecay-cvar25-ere-stumps.yaml")
     t.obstacle_stump, t.obstacle_mix_start = 1.0, TrainConfig().obstacle_mix_start
     assert stumps == ere
+
+
+def test_the_cvar10_ere_config_is_the_ere_run_branched_at_1_1m_with_c_0_1():
+    """Session 47's branch: the ERE run from its full state at 1.1M, with the actor maximising the
+    lowest tenth of the atoms instead of the lowest quarter from there. The branch check accepts
+    it at 1.1M, not a step later, and nothing but c differs."""
+    from bipedal_cli.branch_rules import check_branch_config
+
+    ere, c10 = (
+        resolve_config(CONFIGS / f"hardcore-lrdecay-{n}.yaml") for n in ("cvar25-ere", "cvar10-ere")
+    )
+    assert (c10.agent.actor_cvar, c10.agent.actor_cvar_start) == (0.1, 1_100_000)
+    check_branch_config(ere, c10, 1_100_000, "hardcore-lrdecay-cvar10-ere.yaml")
+    with pytest.raises(UserError, match="actor_cvar"):
+        check_branch_config(ere, c10, 1_100_001, "hardcore-lrdecay-cvar10-ere.yaml")
+    c10.agent.actor_cvar = 0.25
+    assert c10 == ere
 
 
 RESTART_KEYS = tuple(
