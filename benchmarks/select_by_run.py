@@ -5,6 +5,10 @@ windows of policy steps (docs/hardcore.md, session 6). One table per report.
 
     python benchmarks/select_by_run.py docs/runs/hardcore-select-session6.json --every 100000
 
+`--to STEP` leaves out kept policies past STEP, so that runs stopped at different steps are
+summarised over the same span; a policy file named on its own (the shipped one, a run's last
+`policy.pt`) always stays.
+
 A run is the directory that holds `policies/`; a policy file named on its own is its own row.
 Comparing runs this way weighs every kept policy, not the one a selection happens to pick.
 """
@@ -44,11 +48,21 @@ class WindowSummary(NamedTuple):
     mean_length: float
 
 
-def summarise(candidates: list[dict], every: int) -> list[WindowSummary]:
-    """One WindowSummary per (run, window of `every` policy steps), in run then step order."""
+def kept_past(candidate: dict, last_step: int | None) -> bool:
+    """Whether ``candidate`` is a kept policy (``RUN/policies/step-N.pt``) past ``last_step``."""
+    kept = Path(candidate["path"]).parent.name == "policies"
+    return last_step is not None and kept and candidate["step"] > last_step
+
+
+def summarise(
+    candidates: list[dict], every: int, last_step: int | None = None
+) -> list[WindowSummary]:
+    """One WindowSummary per (run, window of `every` policy steps), in run then step order,
+    leaving out kept policies past ``last_step`` (None: none left out)."""
     groups: dict[tuple[str, int], list[dict]] = defaultdict(list)
     for c in candidates:
-        groups[group_of(c, every)].append(c)
+        if not kept_past(c, last_step):
+            groups[group_of(c, every)].append(c)
     rows = []
     for (run, _), group in sorted(groups.items()):
         held = [c["held_out"] for c in group]
@@ -71,7 +85,7 @@ def summarise(candidates: list[dict], every: int) -> list[WindowSummary]:
     return rows
 
 
-def print_report(path: Path, every: int) -> None:
+def print_report(path: Path, every: int, last_step: int | None = None) -> None:
     report = json.loads(path.read_text())
     first, last = report["seeds"]
     print(f"{path}: held-out seeds {first:,}-{last:,}")
@@ -79,7 +93,7 @@ def print_report(path: Path, every: int) -> None:
         "| run | policy steps | policies | mean return | falls per 100 | where they fell "
         "| median | mean length |\n|---|---|---|---|---|---|---|---|"
     )
-    for w in summarise(report["candidates"], every):
+    for w in summarise(report["candidates"], every, last_step):
         steps = f"{w.first_step:,}"
         if w.last_step != w.first_step:
             steps += f"-{w.last_step:,}"
@@ -94,9 +108,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("reports", type=Path, nargs="+", help="`bipedal select --json` files")
     parser.add_argument("--every", type=int, default=0, help="window of policy steps (0: none)")
+    parser.add_argument(
+        "--to", type=int, default=None, help="leave out kept policies past this policy step"
+    )
     args = parser.parse_args()
     for path in args.reports:
-        print_report(path, args.every)
+        print_report(path, args.every, args.to)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ from bipedal_cli.schedule import learning_rate_at
 from bipedal_cli.train import train
 
 from .conftest import tiny_dict
-from .test_train import assert_states_equal
+from .test_train import assert_states_equal, trainable_state
 
 
 def test_learning_rate_is_constant_then_linear_then_final():
@@ -28,11 +28,6 @@ def decaying(**train_keys):
     data = tiny_dict(**train_keys)
     data["agent"].update(lr_final=1e-5, lr_decay_start=200, lr_decay_end=350)
     return data
-
-
-def trainable_state(path):
-    state = load_checkpoint(path / "state.pt")
-    return {k: v for k, v in state.items() if k not in ("path", "config")}
 
 
 def test_branch_equals_the_run_its_config_trains_from_scratch(tmp_path):

@@ -52,6 +52,11 @@ COMMITTED = {
         0,
         "docs/runs/hardcore-lrdecay-cvar10-ere-seed0/metrics.csv",
     ),
+    "hardcore-lrdecay-cvar25-buffer2m-seed0.pt": (
+        "hardcore-lrdecay-cvar25-buffer2m.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-buffer2m-seed0/metrics.csv",
+    ),
     # the branch point of hardcore-lrdecay-cvar25-ere-stumps.yaml (session 46) and
     # hardcore-lrdecay-cvar10-ere.yaml (session 47)
     "hardcore-lrdecay-cvar25-ere-seed0-at-1100000.pt": (

@@ -50,6 +50,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-ere-stumps": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-stumps": HARDCORE_H4,
     "hardcore-lrdecay-cvar10-ere": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-buffer2m": HARDCORE_H4,
     "hardcore-lstm12": HARDCORE_H4[:3] + (12,) + HARDCORE_H4[4:],
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
@@ -288,6 +289,17 @@ def test_the_cvar10_ere_config_is_the_ere_run_branched_at_1_1m_with_c_0_1():
         check_branch_config(ere, c10, 1_100_001, "hardcore-lrdecay-cvar10-ere.yaml")
     c10.agent.actor_cvar = 0.25
     assert c10 == ere
+
+
+def test_the_buffer2m_config_is_its_seed_0_run_with_a_buffer_that_never_wraps_before_2m():
+    """Session 48's run from scratch: the seed-0 run of hardcore-lrdecay-cvar25.yaml with a
+    replay buffer of 2M transitions, more than the run stores to the end of its decay; nothing
+    else may differ."""
+    seed0 = resolve_config(ROOT / "docs/runs/hardcore-lrdecay-cvar25-seed0/config.yaml")
+    big = resolve_config(CONFIGS / "hardcore-lrdecay-cvar25-buffer2m.yaml")
+    assert big.train.buffer_size == 2_000_000 > big.agent.lr_decay_end
+    big.train.buffer_size = 1_000_000
+    assert big == seed0
 
 
 RESTART_KEYS = tuple(

@@ -66,3 +66,15 @@ def test_select_by_run_counts_where_each_window_fell():
     ]
     assert windows[1].falls_per_100 == pytest.approx((10.0 + 5.0) / 2)
     assert windows[1].mean_return == pytest.approx(282.0)
+
+
+def test_select_by_run_to_leaves_out_kept_policies_past_a_step_and_keeps_named_files():
+    select_by_run = load_benchmark("select_by_run")
+    windows = select_by_run.summarise(report()["candidates"], 0, last_step=1_520_000)
+    got = [(w.run, w.first_step, w.last_step, w.policies) for w in windows]
+    assert got == [
+        (heldout_falls.REFERENCE, 1_740_000, 1_740_000, 1),  # named on its own: past, and kept
+        ("runs/a", 1_500_000, 1_520_000, 2),  # 1,600,000 left out
+        ("runs/a/policy.pt", 1_612_345, 1_612_345, 1),
+    ]
+    assert windows[1].falls_per_100 == pytest.approx((10.0 + 5.0) / 2)

@@ -6,8 +6,7 @@ from bipedal_cli.resume import resume
 from bipedal_cli.train import train
 
 from .conftest import tiny_dict
-from .test_branch import trainable_state
-from .test_train import assert_states_equal
+from .test_train import assert_states_equal, trainable_state
 
 
 def test_kept_policies_change_nothing_and_record_their_evaluation(tmp_path):

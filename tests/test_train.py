@@ -182,3 +182,24 @@ def test_resume_on_two_threads_continues_a_one_thread_run_to_the_bit(tmp_path):
         {k: v for k, v in sa.items() if k not in ignore},
         {k: v for k, v in sb.items() if k not in ignore},
     )
+
+
+def test_a_larger_buffer_changes_nothing_until_the_smaller_one_would_wrap(tmp_path):
+    """Sampling reads only how many transitions are stored, so a run with a buffer of 2,000 is
+    the run with a buffer of 400 to the bit while 400 hold everything (session 48's 2M buffer
+    against seed 0's 1M); once the smaller ring wraps, the runs part."""
+    runs = {
+        n: train(config_from_dict(tiny_dict(total_steps=s, buffer_size=n)), tmp_path / str(n))
+        for n, s in ((400, 350), (2000, 350), (250, 350))
+    }
+    assert all(r.steps == 350 for r in runs.values())
+    states = {n: trainable_state(tmp_path / str(n)) for n in runs}
+    assert states[2000]["buffer"]["size"] == states[400]["buffer"]["size"] <= 350
+    assert_states_equal(states[400], states[2000], skip=("/counters/wall_time", "/buffer/capacity"))
+    actors = {n: load_checkpoint(tmp_path / str(n) / "policy.pt")["actor"] for n in runs}
+    assert not all(torch.equal(actors[400][k], actors[250][k]) for k in actors[400])
+
+
+def trainable_state(path):
+    state = load_checkpoint(path / "state.pt")
+    return {k: v for k, v in state.items() if k not in ("path", "config")}
