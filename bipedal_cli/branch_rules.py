@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from .buffer import fits_resized
 from .errors import UserError
 
 BRANCH_MAY_CHANGE = (
@@ -15,6 +16,7 @@ BRANCH_MAY_CHANGE = (
     "train.keep_policies",
     "train.refill_steps",  # read only when a run restarts from a restart.pt
 )
+BUFFER_SIZE = "train.buffer_size"  # only while the run's buffer has never wrapped
 # Features that start at a policy step: (their keys, the key of that step, is-on, its step).
 DEFERRED = (
     (
@@ -102,14 +104,19 @@ def _flat(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     return out
 
 
-def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> None:
+def check_branch_config(
+    run_cfg: Any, new_cfg: Any, step: int, source: str, buffer: dict | None = None
+) -> None:
     """A branch of a run at ``step`` (``bipedal resume RUN --into DIR --config NEW``) must be the
     run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
-    threads, budget and kept policies (they do not change the bits), and features that start
+    threads, budget and kept policies (they do not change the bits), features that start
     at a policy step (DEFERRED: learning-rate decay, replay curation, fall-penalty ramp,
     risk-averse actor, larger batch, restarts near falls, obstacle mix) as long as they change
-    nothing before ``step``. One line naming the first key that breaks this."""
+    nothing before ``step``, and the replay buffer's size while the run's ``buffer`` (its saved
+    state: capacity, size, pos) has never wrapped and fits the new size. One line naming the
+    first key that breaks this."""
     old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
+    _check_buffer_resize(old, new, buffer, source)
     deferred_keys: set[str] = set()
     for keys, start_key, is_on, start in DEFERRED:
         deferred_keys.update(keys)
@@ -121,13 +128,35 @@ def check_branch_config(run_cfg: Any, new_cfg: Any, step: int, source: str) -> N
                 f"{step:,} (the run up to there must stay as it was)"
             )
     for key, value in new.items():
-        if key in BRANCH_MAY_CHANGE or key in deferred_keys or old.get(key) == value:
+        if key in BRANCH_MAY_CHANGE or key == BUFFER_SIZE or key in deferred_keys:
+            continue
+        if old.get(key) == value:
             continue
         raise UserError(
             f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
             "change only device, train.threads, train.total_steps, train.keep_policies, "
-            "train.refill_steps and "
+            "train.refill_steps, train.buffer_size before the buffer wraps, and "
             "features that start at or after the branch point (learning-rate decay, replay "
             "curation, fall-penalty ramp, risk-averse actor, larger batch, restarts near falls, "
             "actor anchor, obstacle mix)"
         )
+
+
+def _check_buffer_resize(old: dict, new: dict, buffer: dict | None, source: str) -> None:
+    """A new ``train.buffer_size`` gives the same run only if the run's ring never wrapped and
+    its transitions fit the new one (:func:`~bipedal_cli.buffer.fits_resized`)."""
+    was, wanted = old[BUFFER_SIZE], new[BUFFER_SIZE]
+    if was == wanted:
+        return
+    if buffer is not None and fits_resized(int(buffer["size"]), int(buffer["pos"]), was, wanted):
+        return
+    held = (
+        f"holds {int(buffer['size']):,} at position {int(buffer['pos']):,}"
+        if buffer
+        else "is unknown"
+    )
+    raise UserError(
+        f"{source}: key {BUFFER_SIZE!r} is {wanted!r}, the run's is {was!r}; a branch may "
+        "change it only while the run's buffer has never wrapped and fits the new size "
+        f"(its buffer {held})"
+    )

@@ -74,7 +74,17 @@ class ReplayBuffer:
         return {"capacity": self.capacity, "size": self.size, "pos": self.pos, **data}
 
     def load_state_dict(self, state: dict) -> None:
+        """Restore ``state``; one saved at another capacity loads only if it never wrapped and
+        fits (:func:`fits_resized`), and then sits where a run of this capacity would hold it."""
         size, pos = int(state["size"]), int(state["pos"])
+        saved_capacity = int(state.get("capacity", self.capacity))
+        if saved_capacity != self.capacity:
+            if not fits_resized(size, pos, saved_capacity, self.capacity):
+                raise ValueError(
+                    f"buffer state (size {size}, pos {pos}, capacity {saved_capacity}) has "
+                    f"wrapped or does not fit capacity {self.capacity}"
+                )
+            pos = size % self.capacity
         if size > self.capacity or not 0 <= pos < self.capacity:
             raise ValueError(
                 f"buffer state (size {size}, pos {pos}) does not fit capacity {self.capacity}"
@@ -82,3 +92,14 @@ class ReplayBuffer:
         for name in self.fields:
             getattr(self, name)[:size] = state[name]
         self.size, self.pos = size, pos
+
+
+def fits_resized(size: int, pos: int, capacity: int, new_capacity: int) -> bool:
+    """Whether a ring of ``capacity`` holding ``size`` transitions at write position ``pos`` is
+    also what a ring of ``new_capacity`` would hold after the same additions.
+
+    A ring that never overwrote a slot (pos == size < capacity) holds transition i in slot i, as
+    any ring of at least ``size`` slots does, and sampling reads only the size. A full ring with
+    pos 0 may have wrapped, so it does not count.
+    """
+    return pos == size < capacity and size <= new_capacity

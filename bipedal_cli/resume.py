@@ -150,11 +150,12 @@ def branch(
     run's config with ``overrides``, ``--set`` texts, then ``explicit`` dotted keys).
 
     ``cfg`` may differ from the run's config only by features that start at or after the run's
-    step (a learning-rate decay, replay curation) and by device, threads, budget and kept
-    policies (:func:`~bipedal_cli.branch_rules.check_branch_config`): the branch is then, to the
-    bit, the run that ``cfg`` trains from scratch, so two recipes can be compared from one
-    shared start. The source is only read; ``into`` gets the source's metrics up to the branch
-    step and its best policy.
+    step (a learning-rate decay, replay curation), by the buffer's size while it has never
+    wrapped, and by device, threads, budget and kept policies
+    (:func:`~bipedal_cli.branch_rules.check_branch_config`): the branch is then, to the bit, the
+    run that ``cfg`` trains from scratch, so two recipes can be compared from one shared start.
+    The source is only read; ``into`` gets the source's metrics up to the branch step and its
+    best policy.
 
     ``path`` may also be a ``restart.pt`` (:func:`~bipedal_cli.run_state.restart_state`), and
     ``cfg`` and ``overrides`` may then be left out: the run goes on from the file's step in
@@ -171,7 +172,7 @@ def branch(
     if cfg is None:
         config_source = f"{state_path}: config + --set"
         cfg = override_config(state["config"], config_source, overrides, **(explicit or {}))
-    check_branch_config(run_cfg, cfg, step, config_source)
+    check_branch_config(run_cfg, cfg, step, config_source, state["buffer"])
     check_budget(cfg.train.total_steps, step, "--steps (train.total_steps)")
     into = prepare_new_run_dir(into, "--into")
     with lock_run_dir(into):

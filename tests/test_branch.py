@@ -66,7 +66,7 @@ def test_branch_equals_the_run_its_config_trains_from_scratch(tmp_path):
     [
         ({"agent": {"gamma": 0.99}}, "agent.gamma"),
         ({"agent": {"lr_decay_start": 100}}, "agent.lr_decay_start"),
-        ({"train": {"buffer_size": 300}}, "train.buffer_size"),
+        ({"train": {"buffer_size": 150}}, "train.buffer_size"),  # 200 transitions do not fit
         ({"train": {"replay_keep_below": 250.0}}, "train.replay_curation_start"),
     ],
 )
@@ -141,3 +141,34 @@ def test_branch_may_start_replay_curation_at_its_step(tmp_path):
     data["train"].update(replay_keep_below=250.0, replay_curation_start=200)
     result = branch(tmp_path / "run", tmp_path / "branch", config_from_dict(data))
     assert result.steps == 260
+
+
+def test_branch_may_resize_a_buffer_that_never_wrapped_and_is_then_the_run_of_that_size(tmp_path):
+    """At step 200 a buffer of 2,000 and one of 250 hold the same 200 transitions in the same
+    slots, so a branch there to either size is, to the bit, the run of that size from scratch:
+    250 wraps after the branch, 2,000 never does."""
+    for size, other in ((250, 2000), (2000, 250)):
+        straight = train(config_from_dict(tiny_dict(buffer_size=size)), tmp_path / f"s{size}")
+        train(
+            config_from_dict(tiny_dict(total_steps=200, buffer_size=other)), tmp_path / f"h{size}"
+        )
+        new = config_from_dict(tiny_dict(buffer_size=size))
+        branched = branch(tmp_path / f"h{size}", tmp_path / f"b{size}", new)
+        assert branched.steps == straight.steps == 400
+        a, b = (trainable_state(tmp_path / f"{k}{size}") for k in ("s", "b"))
+        assert b["buffer"]["capacity"] == size and b["buffer"]["size"] == min(size, 400)
+        assert_states_equal(a, b)
+
+
+@pytest.mark.parametrize(
+    "size, steps, new_size, held",
+    [(250, 300, 2000, "holds 250 at position 50"), (2000, 300, 250, "holds 300 at position 300")],
+)
+def test_branch_refuses_to_resize_a_buffer_that_wrapped_or_does_not_fit(
+    tmp_path, size, steps, new_size, held
+):
+    train(config_from_dict(tiny_dict(total_steps=steps, buffer_size=size)), tmp_path / "run")
+    new = config_from_dict(tiny_dict(buffer_size=new_size))
+    with pytest.raises(UserError, match=f"'train.buffer_size' is {new_size}.*{held}"):
+        branch(tmp_path / "run", tmp_path / "b", new)
+    assert not (tmp_path / "b").exists()

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from bipedal_cli.buffer import ReplayBuffer
+from bipedal_cli.buffer import ReplayBuffer, fits_resized
 
 
 def fill(buf, n, start=0):
@@ -43,3 +43,29 @@ def test_state_round_trip_samples_identically():
 def test_empty_buffer_refuses_to_sample():
     with pytest.raises(ValueError):
         ReplayBuffer(3, 1, 1).sample(1, np.random.default_rng(0))
+
+
+@pytest.mark.parametrize("new_capacity", [4, 5, 9])
+def test_a_ring_that_never_wrapped_loads_into_another_capacity_as_that_ring_would_hold_it(
+    new_capacity,
+):
+    small = ReplayBuffer(6, 3, 2)
+    fill(small, 4)
+    resized, direct = ReplayBuffer(new_capacity, 3, 2), ReplayBuffer(new_capacity, 3, 2)
+    resized.load_state_dict(small.state_dict())
+    fill(direct, 4)
+    fill(resized, 3, start=4)  # and they go on alike, wrapping where the new capacity says
+    fill(direct, 3, start=4)
+    assert (resized.size, resized.pos) == (direct.size, direct.pos)
+    for name in direct.fields:
+        assert np.array_equal(getattr(resized, name), getattr(direct, name)), name
+
+
+def test_a_ring_that_wrapped_or_does_not_fit_refuses_another_capacity():
+    assert fits_resized(4, 4, 6, 4) and not fits_resized(4, 4, 6, 3)
+    assert not fits_resized(6, 0, 6, 10)  # full at position 0: it may have wrapped
+    wrapped = ReplayBuffer(5, 3, 2)
+    fill(wrapped, 7)
+    assert not fits_resized(wrapped.size, wrapped.pos, 5, 10)
+    with pytest.raises(ValueError, match="has wrapped or does not fit capacity 10"):
+        ReplayBuffer(10, 3, 2).load_state_dict(wrapped.state_dict())
