@@ -295,9 +295,18 @@ def test_the_buffer2m_config_is_its_seed_0_run_with_a_buffer_that_never_wraps_be
     """Session 48's run from scratch: the seed-0 run of hardcore-lrdecay-cvar25.yaml with a
     replay buffer of 2M transitions, more than the run stores to the end of its decay; nothing
     else may differ."""
+    from bipedal_cli.branch_rules import check_branch_config
+
     seed0 = resolve_config(ROOT / "docs/runs/hardcore-lrdecay-cvar25-seed0/config.yaml")
     big = resolve_config(CONFIGS / "hardcore-lrdecay-cvar25-buffer2m.yaml")
     assert big.train.buffer_size == 2_000_000 > big.agent.lr_decay_end
+    # its control: its state at 1M branched to seed 0's 1M buffer, while nothing has wrapped
+    held = {"capacity": 2_000_000, "size": 999_999, "pos": 999_999}
+    check_branch_config(big, seed0, 1_000_000, "--set", held)
+    with pytest.raises(UserError, match="train.buffer_size"):
+        check_branch_config(
+            big, seed0, 1_000_002, "--set", held | {"size": 1_000_001, "pos": 1_000_001}
+        )
     big.train.buffer_size = 1_000_000
     assert big == seed0
 
