@@ -117,9 +117,9 @@ def check_branch_config(
     first key that breaks this."""
     old, new = _flat(run_cfg.to_dict()), _flat(new_cfg.to_dict())
     _check_buffer_resize(old, new, buffer, source)
-    deferred_keys: set[str] = set()
+    own_check = {BUFFER_SIZE}  # keys checked above or in the DEFERRED loop
     for keys, start_key, is_on, start in DEFERRED:
-        deferred_keys.update(keys)
+        own_check.update(keys)
         if all(old[k] == new[k] for k in keys):
             continue
         if any(is_on(c) and start(c) < step for c in (run_cfg, new_cfg)):
@@ -128,9 +128,7 @@ def check_branch_config(
                 f"{step:,} (the run up to there must stay as it was)"
             )
     for key, value in new.items():
-        if key in BRANCH_MAY_CHANGE or key == BUFFER_SIZE or key in deferred_keys:
-            continue
-        if old.get(key) == value:
+        if key in BRANCH_MAY_CHANGE or key in own_check or old.get(key) == value:
             continue
         raise UserError(
             f"{source}: key {key!r} is {value!r}, the run's is {old.get(key)!r}; a branch may "
