@@ -6,11 +6,13 @@ larger ones a GPU might afford: policy steps/s of full training and updates/s al
 
 A variant BxU is U gradient updates of B transitions per policy step. Every measurement runs in
 its own subprocess (clean threads, one CUDA context), after ``--warmup`` random policy steps
-that are not timed; the run's risk-averse actor objective (``agent.actor_cvar``) is switched on
-from the start so that each update is a late-run one. "policy steps/s" is full training: the
-environment (with the config's action repeat), the replay buffer and U updates per step.
-"updates/s alone" draws the batches beforehand. CPU measurements use ``--cpu-threads``.
-The printed lines and the machine go to benchmarks/results/device_speed-<date>.json.
+that are not timed; the run's risk-averse actor objective (``agent.actor_cvar``), more
+truncation, the target entropy's decay and the actor's smoothness term, where the config has
+them, are switched on from the start so that each update is a late-run one. "policy steps/s"
+is full training: the environment (with the config's action repeat), the replay buffer and U
+updates per step. "updates/s alone" draws the batches beforehand. CPU measurements use
+``--cpu-threads``. The printed lines and the machine go to
+benchmarks/results/device_speed-<date>.json.
 """
 
 from __future__ import annotations
@@ -83,6 +85,9 @@ def measure(
         "device": device,
         "agent.batch_size": batch,
         "agent.actor_cvar_start": 0,
+        "agent.drop_per_critic_start": 0,
+        "agent.actor_smooth_start": 0,
+        "agent.target_entropy_decay_start": 0,
         "train.updates_per_step": updates,
         "train.warmup_steps": warmup,
         "train.eval_every": 0,

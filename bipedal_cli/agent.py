@@ -10,8 +10,9 @@ from concurrent.futures import Future, ThreadPoolExecutor
 import numpy as np
 import torch
 
+from .actor_penalties import actor_penalties
 from .adam_moments import step_moments_only
-from .anchor import anchor_penalty, anchored
+from .agent_state import agent_state_dict, load_agent_state
 from .config import AgentConfig
 from .losses import actor_loss, quantile_huber_loss, temperature_loss, truncated_target
 from .metrics_when_done import MetricsWhenDone
@@ -46,6 +47,8 @@ class TQCAgent:
         # the actor's objective: the mean of all atoms (None) or of the lowest L (schedule.py)
         self.actor_lowest_atoms: int | None = None
         self.actor_frozen = False  # agent.actor_update_start: True moves the critics only
+        self.actor_smooth: float | None = None  # agent.actor_smooth's weight, once it is on
+        self.drop_per_critic = cfg.drop_per_critic  # k of the targets (set_truncation)
         self.anchor: SquashedGaussianActor | None = None  # the initial actor (set_anchor)
         self._online = list(self.critic.parameters())
         self._target = list(self.critic_target.parameters())
@@ -112,6 +115,13 @@ class TQCAgent:
 
     def learning_rate(self) -> float:
         return float(self.actor_opt.param_groups[0]["lr"])
+
+    def set_truncation(self, drop_per_critic: int) -> None:
+        """k, the atoms per critic the next updates' targets drop (after the critics' last step,
+        whose target the worker may still be computing with the old k)."""
+        if drop_per_critic != self.drop_per_critic:
+            self.sync()
+            self.drop_per_critic = drop_per_critic
 
     def update(self, batch: dict[str, torch.Tensor]) -> Mapping[str, torch.Tensor]:
         """One TQC step on a batch; returns detached 0-dim metric tensors (no host sync here).
@@ -191,7 +201,7 @@ class TQCAgent:
                 next_log_prob,
                 alpha,
                 cfg.gamma,
-                cfg.drop_per_critic,
+                self.drop_per_critic,
                 batch.get("discount") if cfg.n_step > 1 else None,
             )  # (B, K)
         atoms = self.critic(batch["obs"], batch["action"])  # (B, N, M)
@@ -214,8 +224,9 @@ class TQCAgent:
         new_action, log_prob = self.actor.sample(obs, eps=eps)  # (B, A), (B,)
         new_atoms = self.critic(obs, new_action, detach_params=True)  # (B, N, M)
         pi_loss = actor_loss(log_prob, new_atoms, alpha, self.actor_lowest_atoms)
-        if self.anchor is not None and not self.actor_frozen:  # frozen: the actor is its anchor
-            pi_loss = pi_loss + anchor_penalty(self.actor, self.anchor, obs, self.cfg)
+        penalty = actor_penalties(self, obs)  # anchor, smoothness; None when neither is on
+        if penalty is not None:
+            pi_loss = pi_loss + penalty
         self.actor_opt.zero_grad(set_to_none=True)
         pi_loss.backward()
         alpha_loss = temperature_loss(self.log_alpha, log_prob, self.target_entropy)
@@ -255,34 +266,7 @@ class TQCAgent:
 
     # ------------------------------------------------------------- persistence
     def state_dict(self) -> dict:
-        self.sync()
-        return {
-            "actor": self.actor.state_dict(),
-            "critic": self.critic.state_dict(),
-            "critic_target": self.critic_target.state_dict(),
-            "log_alpha": self.log_alpha.detach().cpu(),
-            "actor_opt": self.actor_opt.state_dict(),
-            "critic_opt": self.critic_opt.state_dict(),
-            "alpha_opt": self.alpha_opt.state_dict(),
-            "noise_rng": self.noise.get_state(),
-            "updates": self.updates,
-            "anchor": None if self.anchor is None else self.anchor.state_dict(),
-        }
+        return agent_state_dict(self)
 
     def load_state_dict(self, state: dict) -> None:
-        self.sync()
-        self.actor.load_state_dict(state["actor"])
-        self.critic.load_state_dict(state["critic"])
-        self.critic_target.load_state_dict(state["critic_target"])
-        with torch.no_grad():
-            self.log_alpha.copy_(state["log_alpha"])
-        self.actor_opt.load_state_dict(state["actor_opt"])
-        self.critic_opt.load_state_dict(state["critic_opt"])
-        self.alpha_opt.load_state_dict(state["alpha_opt"])
-        self.noise.set_state(state["noise_rng"])
-        self.updates = int(state["updates"])
-        self.anchor = None
-        if anchored(self.cfg) or state.get("anchor") is not None:
-            self.set_anchor()  # a branch into an anchor (only up to actor_update_start) keeps it
-            if state.get("anchor") is not None:  # older states have no key
-                self.anchor.load_state_dict(state["anchor"])
+        load_agent_state(self, state)

@@ -38,6 +38,11 @@ class AgentConfig:
     """M: quantile atoms per critic."""
     drop_per_critic: int = 2
     """k: atoms dropped from the top of the pooled target per critic (k * N in all)."""
+    drop_per_critic_final: int | None = None
+    """k after ``drop_per_critic_start``: more truncation, a more pessimistic critic under the
+    same actor. None: ``drop_per_critic`` throughout."""
+    drop_per_critic_start: int = 0
+    """Policy step after which the targets drop ``drop_per_critic_final`` atoms per critic."""
     actor_hidden: int = 512
     """Width of the actor's hidden layers."""
     critic_hidden: int = 256
@@ -50,6 +55,14 @@ class AgentConfig:
     """Initial entropy temperature alpha."""
     target_entropy: float | None = None
     """Target entropy H_T; None means -dim(A)."""
+    target_entropy_final: float | None = None
+    """H_T at ``target_entropy_decay_end``, reached linearly from H_T at
+    ``target_entropy_decay_start``: a training policy that ends closer to the deterministic one
+    that is scored. None: H_T throughout."""
+    target_entropy_decay_start: int = 0
+    """Policy step where the target entropy starts to move (H_T up to here)."""
+    target_entropy_decay_end: int = 0
+    """Policy step where it reaches ``target_entropy_final`` (constant after)."""
     log_std_min: float = -20.0
     """Lower clamp of the actor's log standard deviation."""
     log_std_max: float = 2.0
@@ -86,6 +99,15 @@ class AgentConfig:
     """beta: with ``train.init_policy``, the actor's loss adds beta E_s KL(pi(.|s) || pi0(.|s)),
     its divergence from the initial policy: mean and spread, where ``actor_anchor`` holds the
     mean action only. None: off."""
+    actor_smooth: float | None = None
+    """lambda: from ``actor_smooth_start`` on, the actor's loss adds
+    lambda E_s ||mu(s) - mu(s + sigma xi)||_2, xi ~ N(0, I), the distance of its deterministic
+    action at a state from the one at a jittered copy (CAPS's spatial term, Mysore et al.
+    2021): a policy that a small change of what it sees moves less. None: off."""
+    actor_smooth_sigma: float = 0.02
+    """sigma: the standard deviation of the jitter, in the observation's own units."""
+    actor_smooth_start: int = 0
+    """Policy step after which ``actor_smooth`` applies."""
     actor_update_start: int = 0
     """Policy step after which the actor and the temperature learn; up to it only the critics do,
     learning the value of a fixed actor (a run from ``train.init_policy`` warms its new critics

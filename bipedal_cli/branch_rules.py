@@ -84,6 +84,28 @@ DEFERRED = (
         lambda c: c.train.mixes_obstacles(),
         lambda c: c.train.obstacle_mix_start,
     ),
+    (
+        ("agent.drop_per_critic_final", "agent.drop_per_critic_start"),
+        "agent.drop_per_critic_start",
+        lambda c: c.agent.drop_per_critic_final is not None,
+        lambda c: c.agent.drop_per_critic_start,
+    ),
+    (
+        (
+            "agent.target_entropy_final",
+            "agent.target_entropy_decay_start",
+            "agent.target_entropy_decay_end",
+        ),
+        "agent.target_entropy_decay_start",
+        lambda c: c.agent.target_entropy_final is not None,
+        lambda c: c.agent.target_entropy_decay_start,
+    ),
+    (
+        ("agent.actor_smooth", "agent.actor_smooth_sigma", "agent.actor_smooth_start"),
+        "agent.actor_smooth_start",
+        lambda c: c.agent.actor_smooth is not None,
+        lambda c: c.agent.actor_smooth_start,
+    ),
     # the anchor pulls nothing while the actor waits: it is still the anchor itself
     (
         ("agent.actor_anchor", "agent.actor_anchor_kl"),
@@ -111,7 +133,8 @@ def check_branch_config(
     run that ``new_cfg`` trains from scratch: every key equal to the run's except the device,
     threads, budget and kept policies (they do not change the bits), features that start
     at a policy step (DEFERRED: learning-rate decay, replay curation, fall-penalty ramp,
-    risk-averse actor, larger batch, restarts near falls, obstacle mix) as long as they change
+    risk-averse actor, larger batch, restarts near falls, obstacle mix, more truncation, falling
+    target entropy, actor smoothness) as long as they change
     nothing before ``step``, and the replay buffer's size while the run's ``buffer`` (its saved
     state: capacity, size, pos) has never wrapped and fits the new size. One line naming the
     first key that breaks this."""
@@ -136,7 +159,7 @@ def check_branch_config(
             "train.refill_steps, train.buffer_size before the buffer wraps, and "
             "features that start at or after the branch point (learning-rate decay, replay "
             "curation, fall-penalty ramp, risk-averse actor, larger batch, restarts near falls, "
-            "actor anchor, obstacle mix)"
+            "actor anchor, obstacle mix, more truncation, target-entropy decay, actor smoothness)"
         )
 
 

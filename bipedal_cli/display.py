@@ -132,6 +132,12 @@ def scheduled_values(s: dict) -> list[tuple[str, str]]:
         pairs.append(("actor objective", f"CVaR {s['actor_cvar']:g}"))
     if s.get("batch_size") is not None:  # agent.batch_size_final: a larger batch later
         pairs.append(("batch", f"{s['batch_size']:,}"))
+    if s.get("drop_per_critic") is not None:  # agent.drop_per_critic_final: more truncation
+        pairs.append(("atoms dropped/critic", f"{s['drop_per_critic']}"))
+    if s.get("target_entropy") is not None:  # agent.target_entropy_final: a decay
+        pairs.append(("target entropy", _num(s["target_entropy"], "{:.2f}")))
+    if s.get("actor_smooth") is not None:  # agent.actor_smooth: CAPS's spatial term
+        pairs.append(("actor smoothness", f"{s['actor_smooth']:g}"))
     if s.get("updates_per_step") is not None:  # train.updates_per_step_final
         pairs.append(("updates/step", f"{s['updates_per_step']}"))
     if s.get("replay_recency") is not None:  # train.replay_recency: ERE

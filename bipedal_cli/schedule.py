@@ -1,5 +1,6 @@
 """Schedules over policy steps: constant, or linear over a window, for the learning rate and the
-fall penalty the learner sees; from a step on, for the actor's risk-averse objective, the
+fall penalty the learner sees and the target entropy; from a step on, for the actor's
+risk-averse objective, its smoothness term, the truncation of the targets, the
 batch size and the actor's learning at all.
 
 rl-zoo's tuned TQC for BipedalWalkerHardcore-v3 decays its learning rate linearly over the run;
@@ -112,3 +113,42 @@ def fall_penalty_at(step: int, train_cfg: Any) -> float | None:
         t.fall_penalty_ramp_start,
         t.fall_penalty_ramp_end,
     )
+
+
+def drop_per_critic_at(step: int, agent_cfg: Any) -> int:
+    """k(t), the atoms per critic that the targets of the update after policy step ``step``
+    drop from the top of the pooled N*M (:func:`~bipedal_cli.losses.truncated_target`):
+
+    k(t) = drop_per_critic          t <= drop_per_critic_start, or drop_per_critic_final None
+    k(t) = drop_per_critic_final    t > drop_per_critic_start
+    """
+    a = agent_cfg
+    return _switched(step, a.drop_per_critic_start, a.drop_per_critic, a.drop_per_critic_final)
+
+
+def target_entropy_at(step: int, agent_cfg: Any, act_dim: int) -> float:
+    """H_T(t), the entropy that the temperature's loss (eq. 3) steers the policy to in the update
+    after policy step ``step``:
+
+        H_T(t) = H0                                          t <= start
+        H_T(t) = H0 + (final - H0) (t - start) / (end - start)  start < t < end
+        H_T(t) = final                                       t >= end
+
+    H0 = agent.target_entropy, or -dim(A) when it is None; final None: H0 throughout.
+    """
+    a = agent_cfg
+    first = float(-act_dim) if a.target_entropy is None else float(a.target_entropy)
+    return linear_ramp(
+        step,
+        first,
+        a.target_entropy_final,
+        a.target_entropy_decay_start,
+        a.target_entropy_decay_end,
+    )
+
+
+def actor_smooth_at(step: int, agent_cfg: Any) -> float | None:
+    """lambda(t), the weight of the actor's smoothness term in the update after policy step
+    ``step``: agent.actor_smooth when t > actor_smooth_start, else None (no term)."""
+    a = agent_cfg
+    return a.actor_smooth if step > a.actor_smooth_start else None

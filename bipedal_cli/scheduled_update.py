@@ -14,15 +14,19 @@ from .recency import recency_at, recent_window
 from .schedule import (
     actor_frozen,
     actor_lowest_atoms,
+    actor_smooth_at,
     batch_size_at,
+    drop_per_critic_at,
     scheduled_learning_rate,
+    target_entropy_at,
     updates_at,
 )
 
 
 def scheduled_updates(trainer: Any) -> Mapping[str, torch.Tensor] | None:
     """The updates after policy step t = ``trainer.step``: learning rate lr(t), the actor's
-    lowest atoms L(t), whether the actor waits, then U(t) updates of B(t) transitions each,
+    lowest atoms L(t), whether the actor waits, its smoothness weight, the target entropy
+    H_T(t) and the targets' truncation k(t), then U(t) updates of B(t) transitions each,
     drawn from the replay buffer with the trainer's generator (uniformly, or with ERE's emphasis on
     recent transitions: :mod:`bipedal_cli.recency`). Returns the last update's
     metrics (unsynced; None when U(t) is 0)."""
@@ -32,6 +36,9 @@ def scheduled_updates(trainer: Any) -> Mapping[str, torch.Tensor] | None:
         agent.set_learning_rate(lr)
     agent.actor_lowest_atoms = actor_lowest_atoms(step, cfg.agent)
     agent.actor_frozen = actor_frozen(step, cfg.agent)
+    agent.actor_smooth = actor_smooth_at(step, cfg.agent)
+    agent.target_entropy = target_entropy_at(step, cfg.agent, agent.act_dim)
+    agent.set_truncation(drop_per_critic_at(step, cfg.agent))
     batch_size = batch_size_at(step, cfg.agent)
     if trainer.refill_until and moments_missing(agent):  # restarted from a restart file
         estimate_moments(trainer, batch_size)

@@ -12,7 +12,15 @@ from .episodes import curation_keeps, curation_on, obstacle_mix_on
 from .fall_restarts import restarts_on
 from .obstacle_mix import kind_probabilities
 from .recency import recency_at
-from .schedule import actor_frozen, actor_lowest_atoms, batch_size_at, updates_at
+from .schedule import (
+    actor_frozen,
+    actor_lowest_atoms,
+    actor_smooth_at,
+    batch_size_at,
+    drop_per_critic_at,
+    target_entropy_at,
+    updates_at,
+)
 
 
 def replay_kept_share(
@@ -31,6 +39,7 @@ def replay_kept_share(
 def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
     """The display's view of a :class:`~bipedal_cli.train.Trainer` (its losses already read)."""
     recent, falls, t = list(trainer.recent_returns), list(trainer.recent_falls), trainer.cfg.train
+    a = trainer.cfg.agent
     last_eval = trainer.last_eval
     curating = curation_on(t, trainer.step)
     return {
@@ -71,6 +80,18 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
             if trainer.cfg.agent.batch_size_final is not None
             else None
         ),
+        # agent.drop_per_critic_final: atoms each critic's targets drop, once a schedule changes it
+        "drop_per_critic": (
+            drop_per_critic_at(trainer.step, a) if a.drop_per_critic_final is not None else None
+        ),
+        # agent.target_entropy_final: H_T along its decay
+        "target_entropy": (
+            target_entropy_at(trainer.step, a, trainer.agent.act_dim)
+            if a.target_entropy_final is not None
+            else None
+        ),
+        # agent.actor_smooth: the weight of the actor's smoothness term, once it is on
+        "actor_smooth": actor_smooth_at(trainer.step, a),
         # train.updates_per_step_final: updates per policy step, once a schedule changes them
         "updates_per_step": (
             updates_at(trainer.step, t) if t.updates_per_step_final is not None else None

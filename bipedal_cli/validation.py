@@ -11,6 +11,7 @@ import os
 import re
 from typing import Any
 
+from .agent_checks import agent_checks
 from .errors import UserError
 
 REPLAY_CHOICES = ("keep", "clear")  # curriculum.replay
@@ -36,8 +37,6 @@ def check_count(option: str, value: int, limit: int = MAX_EPISODES, low: int = 1
         raise UserError(f"{option} {value}: expected an integer in [{low}, {limit:,}]")
 
 
-ENCODERS = ("none", "lstm")  # agent.encoder: encoders.py
-
 MAX_THREADS = 256  # torch.set_num_threads(100000) crashes the process
 
 
@@ -60,57 +59,7 @@ def validate(cfg: Any, source: str) -> None:
     a, t, c = cfg.agent, cfg.train, cfg.curriculum
     evals = max(t.eval_episodes, t.solved_episodes)
     checks = [
-        (0.0 < a.gamma <= 1.0, "agent.gamma", "a number in (0, 1]"),
-        (a.lr > 0, "agent.lr", "a positive number"),
-        (a.batch_size >= 1, "agent.batch_size", "a positive integer"),
-        (0.0 < a.tau <= 1.0, "agent.tau", "a number in (0, 1]"),
-        (a.n_critics >= 1, "agent.n_critics", "a positive integer"),
-        (a.n_quantiles >= 1, "agent.n_quantiles", "a positive integer"),
-        (
-            0 <= a.drop_per_critic < a.n_quantiles,
-            "agent.drop_per_critic",
-            "an integer in [0, n_quantiles)",
-        ),
-        (a.actor_hidden >= 1, "agent.actor_hidden", "a positive width"),
-        (a.critic_hidden >= 1, "agent.critic_hidden", "a positive width"),
-        (a.n_layers >= 1, "agent.n_layers", "a positive integer"),
-        (a.init_alpha > 0, "agent.init_alpha", "a positive number"),
-        (a.log_std_min < a.log_std_max, "agent.log_std_min", "a number below agent.log_std_max"),
-        (a.actor_hidden <= 65536, "agent.actor_hidden", "at most 65536"),
-        (a.critic_hidden <= 65536, "agent.critic_hidden", "at most 65536"),
-        (a.n_layers <= 64, "agent.n_layers", "at most 64"),
-        (a.n_critics * a.n_quantiles <= 1 << 20, "agent.n_critics", "N * M <= 2^20 atoms"),
-        (a.batch_size <= 1 << 20, "agent.batch_size", "at most 2^20"),
-        (
-            a.batch_size_final is None or 1 <= a.batch_size_final <= 1 << 20,
-            "agent.batch_size_final",
-            "null or an integer in [1, 2^20]",
-        ),
-        (a.batch_size_start >= 0, "agent.batch_size_start", "a non-negative step"),
-        (a.action_repeat >= 1, "agent.action_repeat", "a positive integer"),
-        (a.history >= 1, "agent.history", "a positive integer"),
-        (a.encoder in ENCODERS, "agent.encoder", " or ".join(ENCODERS)),
-        (1 <= a.encoder_hidden <= 4096, "agent.encoder_hidden", "an integer in [1, 4096]"),
-        (a.n_step >= 1, "agent.n_step", "a positive integer"),
-        (a.lr_final is None or a.lr_final >= 0, "agent.lr_final", "null or a number >= 0"),
-        (a.lr_decay_start >= 0, "agent.lr_decay_start", "a non-negative integer"),
-        (
-            a.actor_cvar is None or 0.0 < a.actor_cvar <= 1.0,
-            "agent.actor_cvar",
-            "null or a number in (0, 1]",
-        ),
-        (a.actor_cvar_start >= 0, "agent.actor_cvar_start", "a non-negative step"),
-        (a.actor_update_start >= 0, "agent.actor_update_start", "a non-negative step"),
-        (
-            a.actor_anchor is None or (a.actor_anchor > 0 and t.init_policy is not None),
-            "agent.actor_anchor",
-            "null, or a positive number with train.init_policy set (the actor it anchors to)",
-        ),
-        (
-            a.actor_anchor_kl is None or (a.actor_anchor_kl > 0 and t.init_policy is not None),
-            "agent.actor_anchor_kl",
-            "null, or a positive number with train.init_policy set (the actor it anchors to)",
-        ),
+        *agent_checks(a, t.init_policy),
         (t.init_policy != "", "train.init_policy", "null or the path of a policy file"),
         (
             t.init_policy_sha256 is None or re.fullmatch("[0-9a-f]{64}", t.init_policy_sha256),
@@ -147,11 +96,6 @@ def validate(cfg: Any, source: str) -> None:
             not t.mixes_obstacles() or t.fall_restart == 0,
             "train.fall_restart",
             "0 with an obstacle mix (a restart rebuilds a course from its seed alone)",
-        ),
-        (
-            a.lr_final is None or a.lr_decay_end > a.lr_decay_start,
-            "agent.lr_decay_end",
-            "a step after agent.lr_decay_start (with agent.lr_final set)",
         ),
         (
             t.fall_penalty_final is None or t.fall_penalty is not None,

@@ -128,3 +128,15 @@ def ref_nstep_target(
     pooled = sorted([next_atoms[i, j] for i in range(N) for j in range(M)], key=float)
     kept = pooled[: N * M - k * N]
     return torch.stack([ret + gamma**m * (1.0 - d) * (z - alpha * next_log_prob) for z in kept])
+
+
+def ref_smoothness_loss(action, jittered_action):
+    """E_s ||mu(s) - mu(s~)||_2 (agent.actor_smooth), both actions through the actor."""
+    B, A = action.shape
+    total = 0.0
+    for b in range(B):
+        squared = 0.0
+        for i in range(A):
+            squared = squared + (action[b, i] - jittered_action[b, i]) ** 2
+        total = total + squared**0.5
+    return total / B

@@ -51,6 +51,9 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-stumps": HARDCORE_H4,
     "hardcore-lrdecay-cvar10-ere": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-buffer2m": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-smooth": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-entropy8": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-drop4": HARDCORE_H4,
     "hardcore-lstm12": HARDCORE_H4[:3] + (12,) + HARDCORE_H4[4:],
     "hardcore-warm-anchor100": HARDCORE_H4,
     "hardcore-warm-anchor25": HARDCORE_H4,
@@ -309,6 +312,55 @@ def test_the_buffer2m_config_is_its_seed_0_run_with_a_buffer_that_never_wraps_be
         )
     big.train.buffer_size = 1_000_000
     assert big == seed0
+
+
+# session 49's candidates: (their agent keys from 1.1M, the key the branch check names)
+LATE_CANDIDATES = {
+    "smooth": (
+        {"actor_smooth": 1.0, "actor_smooth_sigma": 0.01, "actor_smooth_start": 1_100_000},
+        "actor_smooth_start",
+    ),
+    "entropy8": (
+        {
+            "target_entropy_final": -8.0,
+            "target_entropy_decay_start": 1_100_000,
+            "target_entropy_decay_end": 1_700_000,
+        },
+        "target_entropy_decay_start",
+    ),
+    "drop4": (
+        {"drop_per_critic_final": 4, "drop_per_critic_start": 1_100_000},
+        "drop_per_critic_start",
+    ),
+}
+
+
+@pytest.mark.parametrize("name", sorted(LATE_CANDIDATES))
+def test_the_late_candidates_are_seed_0s_run_branched_from_the_2m_run_at_1m(name):
+    """Session 49's candidates: the 2M-buffer run's state at 1M, branched to the 1M buffer with
+    one feature that starts at 1.1M. The branch check accepts each there and from the control's
+    state at 1.1M, not a step later, and nothing but the feature's keys differs from seed 0's
+    run."""
+    from dataclasses import fields
+
+    from bipedal_cli.branch_rules import check_branch_config
+    from bipedal_cli.config import AgentConfig
+
+    keys, start_key = LATE_CANDIDATES[name]
+    seed0 = resolve_config(ROOT / "docs/runs/hardcore-lrdecay-cvar25-seed0/config.yaml")
+    big = resolve_config(CONFIGS / "hardcore-lrdecay-cvar25-buffer2m.yaml")
+    cfg = resolve_config(CONFIGS / f"hardcore-lrdecay-cvar25-{name}.yaml")
+    assert {k: getattr(cfg.agent, k) for k in keys} == keys
+    held = {"capacity": 2_000_000, "size": 999_999, "pos": 999_999}
+    source = f"hardcore-lrdecay-cvar25-{name}.yaml"
+    check_branch_config(big, cfg, 1_000_000, source, held)
+    check_branch_config(seed0, cfg, 1_100_000, source)  # or from the control at 1.1M
+    with pytest.raises(UserError, match=start_key):
+        check_branch_config(seed0, cfg, 1_100_001, source)
+    defaults = {f.name: getattr(AgentConfig(), f.name) for f in fields(AgentConfig)}
+    for key in keys:
+        setattr(cfg.agent, key, defaults[key])
+    assert cfg == seed0
 
 
 RESTART_KEYS = tuple(

@@ -1,0 +1,40 @@
+"""The actor's smoothness term (``agent.actor_smooth``): the spatial term of CAPS (Mysore et al.
+2021, "Regularizing Action Policies for Smooth Control"), a penalty on how far the deterministic
+action moves when what the policy sees is jittered.
+
+CAPS also has a temporal term, ||mu(s_t) - mu(s_{t+1})||, between successive states. It is not
+built: with n-step returns the replay buffer stores (s_t, s_{t+n}), not s_{t+1}, and a gait's
+successive actions are meant to differ.
+"""
+
+from __future__ import annotations
+
+import torch
+
+from .networks import SquashedGaussianActor
+
+
+def smoothness_loss(action: torch.Tensor, jittered_action: torch.Tensor) -> torch.Tensor:
+    """J_S = E_s ||mu(s) - mu(s~)||_2, the mean Euclidean distance between the deterministic
+    action at each state and at its jittered copy s~ = s + sigma xi, xi ~ N(0, I).
+
+    action, jittered_action: (B, A), both through the actor (the gradient reaches both, as in
+    CAPS). At equal actions the norm's gradient is taken as zero.
+    """
+    return torch.linalg.vector_norm(action - jittered_action, dim=-1).mean()
+
+
+def smoothness_penalty(
+    actor: SquashedGaussianActor,
+    obs: torch.Tensor,
+    noise: torch.Generator,
+    weight: float,
+    sigma: float,
+) -> torch.Tensor:
+    """lambda J_S on the batch's states, obs (B, D); xi drawn from ``noise`` (the agent's
+    checkpointed generator, so a resumed run draws the same jitter). One forward pass of the
+    actor on the 2B states."""
+    xi = torch.randn(obs.shape, generator=noise, device=obs.device, dtype=obs.dtype)  # (B, D)
+    both = actor.deterministic(torch.cat([obs, obs + sigma * xi]))  # (2B, A)
+    action, jittered_action = both.chunk(2)  # (B, A) each
+    return weight * smoothness_loss(action, jittered_action)
