@@ -133,8 +133,9 @@ def resume(
         typer.Option(
             "--config",
             help="With --into: the branch's config (the run's, plus features that start at or "
-            "after the run's step: learning-rate decay, replay curation, fall-penalty ramp, "
-            "risk-averse actor, larger batch; default: the run's own).",
+            "after the run's step, such as the learning-rate decay, the risk-averse actor or the "
+            "actor's smoothness term, and the buffer's size before it wraps; README lists them; "
+            "default: the run's own).",
         ),
     ] = None,
     set_: Annotated[

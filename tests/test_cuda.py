@@ -116,10 +116,38 @@ def test_actor_loss_on_the_gpu_matches_the_reference(lowest):
         assert torch.allclose(a.cpu(), b, rtol=1e-12, atol=1e-15)
 
 
+def test_smoothness_loss_on_the_gpu_matches_the_reference():
+    from bipedal_cli.smoothness import smoothness_loss
+
+    from .reference import ref_smoothness_loss
+
+    gen = torch.Generator().manual_seed(16)
+    action, jittered = (torch.randn(5, 4, dtype=f64, generator=gen) for _ in range(2))
+    action.requires_grad_()
+    want = ref_smoothness_loss(action, jittered)
+    (g_want,) = torch.autograd.grad(want, action)
+    gpu_action, gpu_jittered = on_gpu(action, jittered)
+    got = smoothness_loss(gpu_action, gpu_jittered)
+    (g_got,) = torch.autograd.grad(got, gpu_action)
+    assert got.item() == pytest.approx(want.item(), rel=1e-12)
+    assert torch.allclose(g_got.cpu(), g_want, rtol=1e-12, atol=1e-15)
+
+
 def on_cuda(total_steps: int, agent: dict = FEATURES) -> dict:
     data = featured(agent, total_steps=total_steps)
     data["device"] = GPU
     data["agent"].update({"actor_cvar": 0.25, "actor_cvar_start": 150})
+    data["agent"].update(  # and every feature that draws noise or changes a target from a step
+        {
+            "actor_smooth": 0.5,
+            "actor_smooth_start": 150,
+            "drop_per_critic_final": 2,
+            "drop_per_critic_start": 150,
+            "target_entropy_final": -6.0,
+            "target_entropy_decay_start": 150,
+            "target_entropy_decay_end": 300,
+        }
+    )
     return data
 
 
