@@ -57,6 +57,13 @@ COMMITTED = {
         0,
         "docs/runs/hardcore-lrdecay-cvar25-buffer2m-seed0/metrics.csv",
     ),
+    # the 2M-buffer run's control, branched from its state at 1M to the 1M buffer of seed 0's
+    # recipe (session 49), at 1.1M: the branch point of the smooth, entropy8 and drop4 configs
+    "hardcore-lrdecay-cvar25-buffer1m-seed0-at-1100000.pt": (
+        "hardcore-lrdecay-cvar25.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-buffer1m-seed0/metrics.csv",
+    ),
     # the branch point of hardcore-lrdecay-cvar25-ere-stumps.yaml (session 46) and
     # hardcore-lrdecay-cvar10-ere.yaml (session 47)
     "hardcore-lrdecay-cvar25-ere-seed0-at-1100000.pt": (
