@@ -78,3 +78,26 @@ def test_the_update_adds_the_term_to_the_actors_loss_only_once_it_is_on():
         losses[on] = agent.update(batch)["actor_loss"].item()
     # the same eq. 2 at the same parameters and noise, plus a positive penalty
     assert losses[5.0] > losses[None]
+
+
+def test_descending_the_penalty_makes_the_actor_less_sensitive_to_a_jitter():
+    cfg = config_from_dict(tiny_dict()).agent
+    torch.manual_seed(6)
+    actor = make_actor(cfg, 24, 4)
+    obs = torch.randn(64, 24, generator=torch.Generator().manual_seed(7))
+    probe = torch.Generator().manual_seed(8)
+
+    def sensitivity() -> float:
+        with torch.no_grad():
+            xi = torch.randn(obs.shape, generator=probe.manual_seed(8))
+            moved = actor.deterministic(obs) - actor.deterministic(obs + 0.1 * xi)
+            return moved.norm(dim=1).mean().item()
+
+    before = sensitivity()
+    opt = torch.optim.Adam(actor.parameters(), lr=1e-2)
+    noise = torch.Generator().manual_seed(9)
+    for _ in range(50):
+        opt.zero_grad()
+        smoothness_penalty(actor, obs, noise, 1.0, 0.1).backward()
+        opt.step()
+    assert sensitivity() < 0.5 * before
