@@ -57,6 +57,12 @@ COMMITTED = {
         0,
         "docs/runs/hardcore-lrdecay-cvar25-buffer2m-seed0/metrics.csv",
     ),
+    # the 2M-buffer run's control (session 49)
+    "hardcore-lrdecay-cvar25-buffer1m-seed0.pt": (
+        "hardcore-lrdecay-cvar25.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-buffer1m-seed0/metrics.csv",
+    ),
     # the 2M-buffer run's control, branched from its state at 1M to the 1M buffer of seed 0's
     # recipe (session 49), at 1.1M: the branch point of the smooth, entropy8 and drop4 configs
     "hardcore-lrdecay-cvar25-buffer1m-seed0-at-1100000.pt": (
