@@ -17,6 +17,7 @@ from .config import AgentConfig
 from .losses import actor_loss, quantile_huber_loss, temperature_loss, truncated_target
 from .metrics_when_done import MetricsWhenDone
 from .networks import SquashedGaussianActor, make_actor, make_critics
+from .schedule import target_entropy_at
 
 
 class TQCAgent:
@@ -35,9 +36,7 @@ class TQCAgent:
         self.log_alpha = torch.tensor(
             float(np.log(cfg.init_alpha)), device=self.device, requires_grad=True
         )
-        self.target_entropy = (
-            float(-act_dim) if cfg.target_entropy is None else float(cfg.target_entropy)
-        )
+        self.target_entropy = target_entropy_at(0, cfg, act_dim)  # H_T; then scheduled_update.py
         adam = {"lr": cfg.lr, "fused": True}  # one kernel per step: 3x the foreach speed on CPU
         self.actor_opt = torch.optim.Adam(self.actor.parameters(), **adam)
         self.critic_opt = torch.optim.Adam(self.critic.parameters(), **adam)

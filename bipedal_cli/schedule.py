@@ -1,11 +1,12 @@
-"""Schedules over policy steps: constant, or linear over a window, for the learning rate and the
+"""Schedules over policy steps: constant, or linear over a window, for the learning rate, the
 fall penalty the learner sees and the target entropy; from a step on, for the actor's
-risk-averse objective, its smoothness term, the truncation of the targets, the
-batch size and the actor's learning at all.
+risk-averse objective and smoothness term, the targets' truncation, the batch size and the
+actor's learning at all.
 
 rl-zoo's tuned TQC for BipedalWalkerHardcore-v3 decays its learning rate linearly over the run;
 ours is constant unless ``agent.lr_final`` is set. The fall penalty is constant unless
-``train.fall_penalty_final`` is set. Each is a pure function of the policy step, so it adds
+``train.fall_penalty_final`` is set, the target entropy unless ``agent.target_entropy_final``
+is. Each is a pure function of the policy step, so it adds
 nothing to a checkpoint and a resumed run follows it exactly.
 """
 
