@@ -25,6 +25,7 @@ thread; the jitter and the policy's draws are seeded by ``--seed``. Its default 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -34,10 +35,13 @@ from record import run_recorded
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from critic_guided import lowest_atoms_mean  # noqa: E402
+
 from bipedal_cli.agent import TQCAgent  # noqa: E402
 from bipedal_cli.checkpoint import load_checkpoint  # noqa: E402
 from bipedal_cli.config import config_from_dict  # noqa: E402
 from bipedal_cli.evaluation import run_episodes, summarize  # noqa: E402
+from bipedal_cli.schedule import actor_lowest_atoms  # noqa: E402
 
 
 def visited_states(agent: TQCAgent, cfg, seeds: list[int]) -> tuple[torch.Tensor, dict]:
@@ -52,16 +56,14 @@ def visited_states(agent: TQCAgent, cfg, seeds: list[int]) -> tuple[torch.Tensor
     return torch.as_tensor(np.concatenate(seen)), summarize(results, cfg.train.solved_threshold)
 
 
-def objective_pull(agent: TQCAgent, obs: torch.Tensor, lowest: int | None) -> torch.Tensor:
+def objective_pull(agent: TQCAgent, obs: torch.Tensor, lowest: int) -> torch.Tensor:
     """||grad_a J(s, a)||_2 at a = mu(s) for each state: (S,). J is the mean of the lowest
-    ``lowest`` pooled atoms, or of all of them when None."""
+    ``lowest`` pooled atoms (all N M: eq. 2's mean)."""
     with torch.no_grad():
         action = agent.actor.deterministic(obs)  # (S, A)
     action.requires_grad_(True)
-    atoms = agent.critic(obs, action).flatten(1)  # (S, N M)
-    if lowest is not None:
-        atoms = atoms.sort(dim=1).values[:, :lowest]
-    (grad,) = torch.autograd.grad(atoms.mean(1).sum(), action)  # (S, A)
+    objective = lowest_atoms_mean(agent.critic(obs, action), lowest)  # (S,)
+    (grad,) = torch.autograd.grad(objective.sum(), action)  # (S, A)
     return grad.norm(dim=1)
 
 
@@ -98,13 +100,15 @@ def main() -> None:
     obs, summary = visited_states(agent, cfg, seeds)
     step = int(data["counters"]["step"])
     n_atoms = cfg.agent.n_critics * cfg.agent.n_quantiles
-    lowest = max(1, int(np.floor(args.fraction * n_atoms + 0.5)))
+    # the actor's own count of lowest atoms for a CVaR fraction c (schedule.py)
+    risk = dataclasses.replace(cfg.agent, actor_cvar=args.fraction, actor_cvar_start=0)
+    lowest = actor_lowest_atoms(1, risk)
     print(
         f"{args.state} at policy step {step:,}: {len(seeds)} episodes (seeds {seeds[0]}.."
         f"{seeds[-1]}), mean {summary['mean']:.1f}, {summary['falls']} fell; "
         f"{obs.shape[0]:,} states"
     )
-    pull_lowest, pull_all = (objective_pull(agent, obs, n) for n in (lowest, None))
+    pull_lowest, pull_all = (objective_pull(agent, obs, n) for n in (lowest, n_atoms))
     print(f"  ||grad_a J||, lowest {lowest} of {n_atoms} atoms: {quartiles(pull_lowest)}")
     print(f"  ||grad_a J||, all atoms (eq. 2): {quartiles(pull_all)}")
     gen = torch.Generator().manual_seed(args.seed)
