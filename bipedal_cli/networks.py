@@ -65,8 +65,19 @@ class SquashedGaussianActor(nn.Module):
         eps ~ N(0, I), (B, A), is drawn from ``generator`` unless given (the agent draws the
         noise of a whole update up front, so that its two halves can run in two threads).
         """
-        u, eps, log_std = self._pre_tanh(obs, generator, eps)
-        return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std)
+        action, log_prob, _ = self.sample_with_mean(obs, generator, eps)
+        return action, log_prob
+
+    def sample_with_mean(
+        self,
+        obs: torch.Tensor,
+        generator: torch.Generator | None = None,
+        eps: torch.Tensor | None = None,
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """:meth:`sample` and, from the same forward pass, the deterministic action tanh(mu):
+        (B, A), (B,), (B, A). The actor's smoothness term needs mu(s) where eq. 2 samples."""
+        u, eps, log_std, mean = self._pre_tanh(obs, generator, eps)
+        return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std), torch.tanh(mean)
 
     def sample_action(
         self, obs: torch.Tensor, generator: torch.Generator | None = None
@@ -76,12 +87,12 @@ class SquashedGaussianActor(nn.Module):
 
     def _pre_tanh(
         self, obs: torch.Tensor, generator: torch.Generator | None, eps: torch.Tensor | None
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """u = mu + sigma * eps, with eps and log sigma: (B, A) each."""
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+        """u = mu + sigma * eps, with eps, log sigma and mu: (B, A) each."""
         mean, log_std = self.distribution_params(obs)
         if eps is None:
             eps = torch.randn(mean.shape, generator=generator, device=mean.device, dtype=mean.dtype)
-        return mean + log_std.exp() * eps, eps, log_std
+        return mean + log_std.exp() * eps, eps, log_std, mean
 
 
 def squashed_gaussian_log_prob(
