@@ -31,6 +31,7 @@ from .errors import UserError
 from .rundir import lock_run_dir, prepare_new_run_dir
 from .sweep_space import base_params, suggest
 from .sweep_storage import make_gate, open_storage
+from .sweep_trials import fail_dead_local_trials, live_count, retry
 
 SWEEP_ROOT = Path("sweeps")
 DEFINITION = "bipedal"  # the study's user attribute holding its definition
@@ -188,48 +189,6 @@ def objective(trial, settings: SweepSettings, make_reporter: Callable[[int], Any
     return budget + UNSOLVED_MARGIN - (max(evals) if evals else -UNSOLVED_MARGIN)
 
 
-def _live_count(study) -> tuple[int, bool]:
-    """(trials that count against the budget: all but failed ones, whether one is waiting)."""
-    from optuna.trial import TrialState
-
-    trials = study.get_trials(deepcopy=False)
-    live = sum(t.state != TrialState.FAIL for t in trials)
-    return live, any(t.state == TrialState.WAITING for t in trials)
-
-
-def _fail_dead_local_trials(study) -> None:
-    """Journal storage has no heartbeat: a RUNNING trial of a worker on this machine whose
-    process is gone is marked failed and its parameters queued again."""
-    from optuna.trial import TrialState
-
-    host = socket.gethostname()
-    for t in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
-        owner = str(t.user_attrs.get("worker", ""))
-        name, _, pid = owner.rpartition(":")
-        if name != host or not pid.isdigit() or _alive(int(pid)):
-            continue
-        study.tell(t.number, state=TrialState.FAIL)
-        _retry(study, t)
-
-
-def _retry(study, trial) -> None:
-    """Queue a failed or interrupted trial's parameters again, marked as its retry."""
-    attrs = {"retry_of": trial.number}
-    if trial.user_attrs.get("baseline"):
-        attrs["baseline"] = True
-    study.enqueue_trial(trial.params, user_attrs=attrs)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
 def run_worker(
     settings: SweepSettings,
     make_reporter: Callable[[int], Any],
@@ -259,8 +218,8 @@ def run_worker(
         gate.acquire()
         try:
             optuna.storages.fail_stale_trials(study)
-            _fail_dead_local_trials(study)
-            live, waiting = _live_count(study)
+            fail_dead_local_trials(study)
+            live, waiting = live_count(study)
             if live >= settings.trials and not waiting:
                 break
         except BaseException:
@@ -278,7 +237,7 @@ def run_worker(
         try:
             study.optimize(func, n_trials=1, catch=(TrialFailed,), gc_after_trial=False)
         except SweepInterrupted as exc:
-            _retry(study, study.trials[ran[-1]])
+            retry(study, study.trials[ran[-1]])
             result.ran += ran
             result.signal = exc.signum
             return result
