@@ -221,36 +221,6 @@ def actor_loss(
     return (alpha * log_prob - value).mean()
 
 
-def anchor_loss(action: torch.Tensor, anchor_action: torch.Tensor) -> torch.Tensor:
-    """The actor's distance from the policy a run started from (``agent.actor_anchor``):
-
-        J_anchor = E_s[ sum_i (mu_i(s) - mu0_i(s))^2 ]
-
-    mu(s) = tanh(mean) is the actor's deterministic action and mu0(s) the initial actor's, a
-    constant; action, anchor_action: (B, A). TD3+BC's term, with the initial policy in place of
-    the data's actions.
-    """
-    return (action - anchor_action.detach()).pow(2).sum(-1).mean()
-
-
-def kl_anchor_loss(
-    mean: torch.Tensor, log_std: torch.Tensor, mean0: torch.Tensor, log_std0: torch.Tensor
-) -> torch.Tensor:
-    """KL(pi || pi0) of the actor from the policy a run started from (``agent.actor_anchor_kl``):
-
-        J_KL = E_s[ sum_i log(sigma0_i / sigma_i) + (sigma_i^2 + (mu_i - mu0_i)^2) / (2 sigma0_i^2)
-                    - 1/2 ]
-
-    mean, log_std: (B, A), the actor's Gaussian before tanh; mean0, log_std0 the initial actor's,
-    constants. tanh is one-to-one, so this is also the KL of the squashed policies. Unlike
-    :func:`anchor_loss` it holds the spread as well as the mean action.
-    """
-    mean0, log_std0 = mean0.detach(), log_std0.detach()
-    var_ratio = torch.exp(2 * (log_std - log_std0))  # sigma^2 / sigma0^2
-    shift = (mean - mean0).pow(2) * torch.exp(-2 * log_std0)  # (mu - mu0)^2 / sigma0^2
-    return (log_std0 - log_std + 0.5 * (var_ratio + shift) - 0.5).sum(-1).mean()
-
-
 def temperature_loss(log_alpha: torch.Tensor, log_prob: torch.Tensor, target_entropy: float):
     """Eq. (3): J(alpha) = E[log alpha * (-log pi(a|s) - H_T)].
 

@@ -169,7 +169,7 @@ def test_count_below_matches_searchsorted_left_and_right(K):
 
 
 def test_anchor_loss_matches_reference_value_and_gradient():
-    from bipedal_cli.losses import anchor_loss
+    from bipedal_cli.anchor import anchor_loss
 
     from .reference import ref_anchor_loss
 
@@ -187,7 +187,7 @@ def test_anchor_loss_matches_reference_value_and_gradient():
 
 
 def test_kl_anchor_loss_matches_reference_value_and_gradient():
-    from bipedal_cli.losses import kl_anchor_loss
+    from bipedal_cli.anchor import kl_anchor_loss
 
     from .reference import ref_kl_anchor_loss
 
