@@ -70,6 +70,18 @@ COMMITTED = {
         0,
         "docs/runs/hardcore-lrdecay-cvar25-buffer1m-seed0/metrics.csv",
     ),
+    # the candidates' control, restarted on a new machine from the file above (session 50)
+    "hardcore-lrdecay-cvar25-control-seed0.pt": (
+        "hardcore-lrdecay-cvar25.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-control-seed0/metrics.csv",
+    ),
+    # the smoothness candidate, restarted from the same file under its config (session 50)
+    "hardcore-lrdecay-cvar25-smooth-seed0.pt": (
+        "hardcore-lrdecay-cvar25-smooth.yaml",
+        0,
+        "docs/runs/hardcore-lrdecay-cvar25-smooth-seed0/metrics.csv",
+    ),
     # the branch point of hardcore-lrdecay-cvar25-ere-stumps.yaml (session 46) and
     # hardcore-lrdecay-cvar10-ere.yaml (session 47)
     "hardcore-lrdecay-cvar25-ere-seed0-at-1100000.pt": (
