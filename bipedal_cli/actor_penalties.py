@@ -12,11 +12,9 @@ from .anchor import anchor_penalty
 from .smoothness import smoothness_penalty
 
 
-def actor_penalties(
-    agent: Any, obs: torch.Tensor, mean_action: torch.Tensor
-) -> torch.Tensor | None:
+def actor_penalties(agent: Any, obs: torch.Tensor, mean: torch.Tensor) -> torch.Tensor | None:
     """The terms on for the update in progress, summed, on the batch's states obs (B, D), where
-    the actor's deterministic action is mean_action (B, A), with its gradient; None
+    the actor's Gaussian mean before tanh is mean (B, A), with its gradient; None
     when none is (the actor's loss is eq. 2 alone, to the bit). While the actor is frozen
     (``agent.actor_update_start``) it does not move, so none applies: it is its own anchor."""
     if agent.actor_frozen:
@@ -28,7 +26,7 @@ def actor_penalties(
         smooth = smoothness_penalty(
             agent.actor,
             obs,
-            mean_action,
+            mean,
             agent.noise,
             agent.actor_smooth,
             agent.cfg.actor_smooth_sigma,

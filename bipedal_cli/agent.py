@@ -220,10 +220,10 @@ class TQCAgent:
     ) -> dict[str, torch.Tensor]:
         """grad J_pi(phi) of eq. (2) through the critics (their weights frozen), grad J(alpha)
         of eq. (3)."""
-        new_action, log_prob, mean_action = self.actor.sample_with_mean(obs, eps=eps)  # (B, A)
+        new_action, log_prob, mean = self.actor.sample_with_mean(obs, eps=eps)  # (B, A)
         new_atoms = self.critic(obs, new_action, detach_params=True)  # (B, N, M)
         pi_loss = actor_loss(log_prob, new_atoms, alpha, self.actor_lowest_atoms)
-        penalty = actor_penalties(self, obs, mean_action)  # anchor, smoothness; None if neither
+        penalty = actor_penalties(self, obs, mean)  # anchor, smoothness; None if neither
         if penalty is not None:
             pi_loss = pi_loss + penalty
         self.actor_opt.zero_grad(set_to_none=True)

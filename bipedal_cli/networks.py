@@ -74,10 +74,11 @@ class SquashedGaussianActor(nn.Module):
         generator: torch.Generator | None = None,
         eps: torch.Tensor | None = None,
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        """:meth:`sample` and, from the same forward pass, the deterministic action tanh(mu):
-        (B, A), (B,), (B, A). The actor's smoothness term needs mu(s) where eq. 2 samples."""
+        """:meth:`sample` and, from the same forward pass, the Gaussian's mean mu before tanh:
+        (B, A), (B,), (B, A). The actor's smoothness term needs tanh(mu(s)) where eq. 2 samples;
+        it applies the tanh itself, so an update without the term does no extra work."""
         u, eps, log_std, mean = self._pre_tanh(obs, generator, eps)
-        return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std), torch.tanh(mean)
+        return torch.tanh(u), squashed_gaussian_log_prob(u, eps, log_std), mean
 
     def sample_action(
         self, obs: torch.Tensor, generator: torch.Generator | None = None

@@ -27,15 +27,16 @@ def smoothness_loss(action: torch.Tensor, jittered_action: torch.Tensor) -> torc
 def smoothness_penalty(
     actor: SquashedGaussianActor,
     obs: torch.Tensor,
-    action: torch.Tensor,
+    mean: torch.Tensor,
     noise: torch.Generator,
     weight: float,
     sigma: float,
 ) -> torch.Tensor:
-    """lambda J_S on the batch's states, obs (B, D). action = mu(s), (B, A), is the actor's own
-    at obs, from the forward pass that eq. 2's sample made (:meth:`sample_with_mean`), so only
-    the B jittered states run through the actor again. xi is drawn from ``noise`` (the agent's
-    checkpointed generator, so a resumed run draws the same jitter)."""
+    """lambda J_S on the batch's states, obs (B, D). mean, (B, A), is the actor's Gaussian mean
+    before tanh at obs, from the forward pass that eq. 2's sample made (:meth:`sample_with_mean`),
+    so mu(s) = tanh(mean) and only the B jittered states run through the actor again. xi is
+    drawn from ``noise`` (the agent's checkpointed generator, so a resumed run draws the same
+    jitter)."""
     xi = torch.randn(obs.shape, generator=noise, device=obs.device, dtype=obs.dtype)  # (B, D)
     jittered_action = actor.deterministic(obs + sigma * xi)  # (B, A)
-    return weight * smoothness_loss(action, jittered_action)
+    return weight * smoothness_loss(torch.tanh(mean), jittered_action)

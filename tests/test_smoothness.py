@@ -43,7 +43,7 @@ def test_penalty_is_the_weighted_loss_at_jittered_states_drawn_from_the_generato
     obs = torch.randn(5, 24, dtype=torch.float64, generator=torch.Generator().manual_seed(3))
     noise = torch.Generator().manual_seed(4)
     replay = torch.Generator().manual_seed(4)
-    got = smoothness_penalty(actor, obs, actor.deterministic(obs), noise, 0.7, 0.05)
+    got = smoothness_penalty(actor, obs, actor.distribution_params(obs)[0], noise, 0.7, 0.05)
     xi = torch.randn(obs.shape, generator=replay, dtype=torch.float64)
     want = 0.7 * ref_smoothness_loss(actor.deterministic(obs), actor.deterministic(obs + 0.05 * xi))
     assert got.item() == pytest.approx(want.item(), rel=1e-12)
@@ -64,11 +64,11 @@ def test_the_penalty_from_the_samples_own_forward_pass_is_the_one_on_2b_states()
     actor = make_actor(cfg, 24, 4)
     obs = torch.randn(32, 24, generator=torch.Generator().manual_seed(11))
     eps = torch.randn(32, 4, generator=torch.Generator().manual_seed(12))
-    action, log_prob, mean_action = actor.sample_with_mean(obs, eps=eps)
+    action, log_prob, mean = actor.sample_with_mean(obs, eps=eps)
     sampled_action, sampled_log_prob = actor.sample(obs, eps=eps)
     assert torch.equal(action, sampled_action) and torch.equal(log_prob, sampled_log_prob)
-    assert torch.equal(mean_action, actor.deterministic(obs))
-    got = smoothness_penalty(actor, obs, mean_action, torch.Generator().manual_seed(13), 2.0, 0.01)
+    assert torch.equal(torch.tanh(mean), actor.deterministic(obs))
+    got = smoothness_penalty(actor, obs, mean, torch.Generator().manual_seed(13), 2.0, 0.01)
     xi = torch.randn(obs.shape, generator=torch.Generator().manual_seed(13))
     both = actor.deterministic(torch.cat([obs, obs + 0.01 * xi]))  # (2B, A)
     want = 2.0 * smoothness_loss(*both.chunk(2))
@@ -122,6 +122,8 @@ def test_descending_the_penalty_makes_the_actor_less_sensitive_to_a_jitter():
     noise = torch.Generator().manual_seed(9)
     for _ in range(50):
         opt.zero_grad()
-        smoothness_penalty(actor, obs, actor.deterministic(obs), noise, 1.0, 0.1).backward()
+        smoothness_penalty(
+            actor, obs, actor.distribution_params(obs)[0], noise, 1.0, 0.1
+        ).backward()
         opt.step()
     assert sensitivity() < 0.5 * before
