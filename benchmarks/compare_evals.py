@@ -29,13 +29,18 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from bipedal_cli.metrics import COLUMNS, FRESH_KINDS, METRICS_FILE, read_metrics  # noqa: E402
 
 
+def run_rows(path: Path) -> list[dict]:
+    """The metrics rows of a run directory or of a metrics.csv file."""
+    return read_metrics(path if path.is_file() else path / METRICS_FILE)
+
+
 def evaluations(
     path: Path, first: int, kind: str = "eval", last: int | None = None, axis: str = "step"
 ) -> dict[int, tuple[float, int]]:
     """{position: (mean return, falls)} of the ``kind`` rows with ``first`` <= position <=
     ``last``, where position is the row's ``axis`` column: "step" (policy steps) or
     "env_steps"."""
-    rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
+    rows = run_rows(path)
     end = last if last is not None else 1 << 62
     return {
         int(r[axis]): (float(r["return"]), int(float(r["fell"])))
@@ -45,12 +50,12 @@ def evaluations(
 
 
 def training_episodes(
-    path: Path, first: int, last: int | None = None, axis: str = "step"
+    path: Path | list[dict], first: int, last: int | None = None, axis: str = "step"
 ) -> tuple[int, float, float]:
     """Fresh training episodes (probes of the deterministic policy included, restarts near
     falls not) ending after ``first`` (and at or before ``last``) on ``axis``: count, mean env
-    return, fraction that fell."""
-    rows = read_metrics(path if path.is_file() else path / METRICS_FILE)
+    return, fraction that fell. ``path`` may be the run's rows, already read (:func:`run_rows`)."""
+    rows = run_rows(path) if isinstance(path, Path) else path
     end = last if last is not None else 1 << 62
     mine = [r for r in rows if r["kind"] in FRESH_KINDS and first < int(r[axis]) <= end]
     if not mine:

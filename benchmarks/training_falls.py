@@ -17,9 +17,12 @@ import argparse
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from compare_evals import training_episodes  # noqa: E402
+from compare_evals import run_rows, training_episodes  # noqa: E402
+
+from bipedal_cli.metrics import METRICS_FILE  # noqa: E402
 
 
 def windows(first: int, last: int, every: int) -> list[tuple[int, int]]:
@@ -31,10 +34,12 @@ def windows(first: int, last: int, every: int) -> list[tuple[int, int]]:
 
 
 def fall_shares(path: Path, spans: list[tuple[int, int]]) -> list[tuple[int, float]]:
-    """(episodes, share that fell) of the run at ``path`` in each (A, B] span."""
+    """(episodes, share that fell) of the run at ``path`` in each (A, B] span (its metrics
+    read once)."""
+    rows = run_rows(path)
     out = []
     for a, b in spans:
-        count, _, fell = training_episodes(path, a, b)
+        count, _, fell = training_episodes(rows, a, b)  # count, mean return, share that fell
         out.append((count, fell))
     return out
 
@@ -64,8 +69,8 @@ def main(argv: list[str] | None = None) -> None:
     except ValueError as e:
         ap.error(str(e))
     for run in args.runs:
-        if not (run if run.is_file() else run / "metrics.csv").exists():
-            ap.error(f"{run}: no metrics.csv there (expected a run directory or a metrics.csv)")
+        if not (run if run.is_file() else run / METRICS_FILE).exists():
+            ap.error(f"{run}: no {METRICS_FILE} there (expected a run directory or the file)")
     print(table(args.runs, spans))
 
 
