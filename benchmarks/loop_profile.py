@@ -21,8 +21,8 @@ from bipedal_cli.config import config_from_dict
 from bipedal_cli.reporting import NullReporter
 from bipedal_cli.train import Trainer
 
-MAIN = ("sync", "_actor_gradients", "_actor_step", "act", "env.step", "sample", "batch_to_tensors")
-WORKER = ("_critic_gradients", "_critic_step")
+MAIN = ("sync", "actor_gradients", "actor_step", "act", "env.step", "sample", "batch_to_tensors")
+WORKER = ("critic_gradients", "critic_step")
 
 
 def main() -> None:

@@ -68,5 +68,17 @@ def estimate_moments(trainer: Any, batch_size: int) -> int:
     )
     for _ in range(batches):
         batch = agent.batch_to_tensors(trainer.buffer.sample(batch_size, trainer.rng))
-        agent.accumulate_moments(batch)
+        accumulate_moments(agent, batch)
     return batches
+
+
+def accumulate_moments(agent: Any, batch: dict[str, torch.Tensor]) -> None:
+    """The gradients of :meth:`TQCAgent.update <bipedal_cli.agent.TQCAgent.update>` on
+    ``batch``, into the actor's and critics' Adam moments only (:func:`step_moments_only`): no
+    weight, target or temperature moves."""
+    agent.sync()
+    eps, alpha = agent.update_noise(batch["obs"]), agent.log_alpha.detach().exp()
+    agent.critic_gradients(batch, eps[1], alpha)
+    agent.actor_gradients(batch["obs"], eps[0], alpha)
+    step_moments_only(agent.critic_opt)
+    step_moments_only(agent.actor_opt)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import copy
 import threading
 from collections.abc import Mapping
-from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 import torch
@@ -14,6 +13,7 @@ from .actor_penalties import actor_penalties
 from .adam_moments import step_moments_only
 from .agent_state import agent_state_dict, load_agent_state
 from .config import AgentConfig
+from .critic_worker import CriticWorker
 from .losses import actor_loss, quantile_huber_loss, temperature_loss, truncated_target
 from .metrics_when_done import MetricsWhenDone
 from .networks import SquashedGaussianActor, make_actor, make_critics
@@ -27,8 +27,7 @@ class TQCAgent:
         self, cfg: AgentConfig, obs_dim: int, act_dim: int, device: torch.device | str = "cpu"
     ) -> None:
         self.cfg, self.obs_dim, self.act_dim = cfg, obs_dim, act_dim
-        self._worker: ThreadPoolExecutor | None = None
-        self._critic_step_job: Future | None = None  # the last update's, on the worker
+        self._worker: CriticWorker | None = None  # start_worker
         self.device = torch.device(device)
         self.actor = make_actor(cfg, obs_dim, act_dim).to(self.device)
         self.critic = make_critics(cfg, obs_dim, act_dim).to(self.device)
@@ -57,24 +56,15 @@ class TQCAgent:
         self.anchor = copy.deepcopy(self.actor).requires_grad_(False)
 
     def start_worker(self, flush_denormal: bool = True) -> None:
-        """Run the critics' part of every update on a second thread (CPU, 2+ cores).
-
-        Meant for one intra-op thread per part, ``torch.set_num_threads(1)``: batch-64 matrix
-        products split badly across cores, two independent parts split well. Denormal
-        flushing is a per-thread CPU flag, so the worker sets its own.
-        """
+        """Run the critics' part of every update on a second thread (CPU, 2+ cores;
+        :class:`~bipedal_cli.critic_worker.CriticWorker`)."""
         if self._worker is None:
-            self._worker = ThreadPoolExecutor(
-                1, "tqc-critic", initializer=torch.set_flush_denormal, initargs=(flush_denormal,)
-            )
+            self._worker = CriticWorker(flush_denormal)
 
     def stop_worker(self) -> None:
-        try:
-            self.sync()
-        finally:
-            if self._worker is not None:
-                self._worker.shutdown()
-                self._worker = None
+        if self._worker is not None:
+            worker, self._worker = self._worker, None
+            worker.shutdown()
 
     def sync(self) -> None:
         """Wait for the critics' step of the last update, which the worker may still be running.
@@ -82,9 +72,8 @@ class TQCAgent:
         Everything here that reads the critics calls it first; code outside that reads
         ``critic``/``critic_target`` directly between updates must too.
         """
-        if self._critic_step_job is not None:
-            job, self._critic_step_job = self._critic_step_job, None
-            job.result()
+        if self._worker is not None:
+            self._worker.wait()
 
     # ------------------------------------------------------------------ acting
     @torch.inference_mode()
@@ -140,23 +129,23 @@ class TQCAgent:
         """
         self.sync()  # the actor loss reads the critics: their last step must be done
         obs, alpha = batch["obs"], self.log_alpha.detach().exp()
-        eps = self._update_noise(obs)
+        eps = self.update_noise(obs)
         if self._worker is None:
-            critic_metrics = self._critic_gradients(batch, eps[1], alpha)
-            actor_metrics = self._actor_gradients(obs, eps[0], alpha)
-            self._critic_step()
-            self._actor_step()
+            critic_metrics = self.critic_gradients(batch, eps[1], alpha)
+            actor_metrics = self.actor_gradients(obs, eps[0], alpha)
+            self.critic_step()
+            self.actor_step()
             self.updates += 1
             return {**critic_metrics, **actor_metrics, "alpha": alpha}
         actor_read, critic_read = threading.Event(), threading.Event()
         job = self._worker.submit(self._critic_part, batch, eps[1], alpha, actor_read, critic_read)
         try:
-            actor_metrics = self._actor_gradients(obs, eps[0], alpha)
+            actor_metrics = self.actor_gradients(obs, eps[0], alpha)
         finally:
             critic_read.set()  # set even after an error: never leave the worker waiting
             actor_read.wait()  # the worker sets it even when it fails
-        self._critic_step_job = job
-        self._actor_step()
+        self._worker.hold(job)
+        self.actor_step()
         self.updates += 1
         return MetricsWhenDone(job, {**actor_metrics, "alpha": alpha})
 
@@ -171,14 +160,14 @@ class TQCAgent:
         """The worker's share of :meth:`update`: critic gradients, then (after the actor loss
         has read the critics) their step."""
         try:
-            metrics = self._critic_gradients(batch, eps, alpha, actor_read)
+            metrics = self.critic_gradients(batch, eps, alpha, actor_read)
         finally:
             actor_read.set()
         critic_read.wait()
-        self._critic_step()
+        self.critic_step()
         return metrics
 
-    def _critic_gradients(
+    def critic_gradients(
         self,
         batch: dict[str, torch.Tensor],
         eps: torch.Tensor,
@@ -209,13 +198,13 @@ class TQCAgent:
         critic_loss.backward()
         return {"critic_loss": critic_loss.detach(), "q_mean": atoms.detach().mean()}
 
-    def _critic_step(self) -> None:
+    def critic_step(self) -> None:
         """Adam on the critics, then Polyak: psi_bar <- tau psi + (1 - tau) psi_bar."""
         self.critic_opt.step()
         with torch.no_grad():
             torch._foreach_lerp_(self._target, self._online, self.cfg.tau)
 
-    def _actor_gradients(
+    def actor_gradients(
         self, obs: torch.Tensor, eps: torch.Tensor, alpha: torch.Tensor
     ) -> dict[str, torch.Tensor]:
         """grad J_pi(phi) of eq. (2) through the critics (their weights frozen), grad J(alpha)
@@ -237,7 +226,7 @@ class TQCAgent:
             "entropy": -log_prob.detach().mean(),
         }
 
-    def _actor_step(self) -> None:
+    def actor_step(self) -> None:
         """Adam on the actor and the temperature; while :attr:`actor_frozen` a step of size zero,
         theta <- theta - 0 * m_hat / (sqrt(v_hat) + eps): the parameters stay, the moments
         average the gradients (a fresh Adam's first steps are lr * sign(g) on every weight)."""
@@ -247,21 +236,10 @@ class TQCAgent:
             else:
                 opt.step()
 
-    def _update_noise(self, obs: torch.Tensor) -> torch.Tensor:
+    def update_noise(self, obs: torch.Tensor) -> torch.Tensor:
         """(2, B, A): eps[0] draws a ~ pi(.|s) for eqs. 2-3, eps[1] a' ~ pi(.|s') for the target."""
         shape = (2, obs.shape[0], self.act_dim)
         return torch.randn(shape, generator=self.noise, device=self.device, dtype=obs.dtype)
-
-    def accumulate_moments(self, batch: dict[str, torch.Tensor]) -> None:
-        """The gradients of :meth:`update` on ``batch``, into the actor's and critics' Adam
-        moments only (:func:`~bipedal_cli.adam_moments.step_moments_only`): no weight, target or
-        temperature moves (:func:`~bipedal_cli.adam_moments.estimate_moments`)."""
-        self.sync()
-        eps, alpha = self._update_noise(batch["obs"]), self.log_alpha.detach().exp()
-        self._critic_gradients(batch, eps[1], alpha)
-        self._actor_gradients(batch["obs"], eps[0], alpha)
-        step_moments_only(self.critic_opt)
-        step_moments_only(self.actor_opt)
 
     # ------------------------------------------------------------- persistence
     def state_dict(self) -> dict:

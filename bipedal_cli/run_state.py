@@ -76,8 +76,8 @@ def run_state(trainer: Any, replay: bool = True) -> dict[str, Any]:
         # so that an episode ending right after a resume still logs its losses
         "update_metrics": (
             None
-            if trainer._update_metrics is None
-            else {k: float(v) for k, v in trainer._update_metrics.items()}
+            if trainer.update_metrics is None
+            else {k: float(v) for k, v in trainer.update_metrics.items()}
         ),
     }
 
@@ -107,7 +107,7 @@ def restore_run_state(trainer: Any, state: dict[str, Any]) -> None:
     trainer.curriculum = state.get("curriculum")
     warn_if_other_machine(trainer, state.get("machine"))
     m = state.get("update_metrics")
-    trainer._update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
+    trainer.update_metrics = None if m is None else {k: torch.tensor(v) for k, v in m.items()}
     ep = state["episode"]
     if ep["obs"] is not None:
         # checkpoints before the fall-penalty ramp had one penalty: the config's

@@ -1,4 +1,6 @@
-"""The training loop: warm-up, one (or more) TQC updates per policy step, evaluation, checkpoints.
+"""A training run: its trainer (agent, buffer, env, counters, generators) and its lifecycle;
+the loop itself (warm-up, TQC updates, evaluations, checkpoints) is
+:mod:`bipedal_cli.training_loop`.
 
 A run lives in one directory (:mod:`bipedal_cli.rundir`): ``config.yaml``, ``metrics.csv``,
 ``state.pt`` (everything an exact resume needs), ``restart.pt`` (the same without the replay
@@ -17,7 +19,6 @@ counts those.
 from __future__ import annotations
 
 import signal
-import time
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -34,13 +35,13 @@ from .checkpoint import STATE_FILE, atomic_save, initial_actor_state
 from .config import Config
 from .devices import configure_threads, resolve_device
 from .envs import policy_dims
-from .episode_record import record_episode, start_episode
+from .episode_record import start_episode
 from .episodes import EpisodeRunner
 from .fall_restarts import FallMemory
 from .metrics import METRICS_FILE, MetricsWriter
-from .periodic_eval import evaluate_on_eval_seeds, periodic_evaluation
+from .periodic_eval import evaluate_on_eval_seeds
 from .reporting import NullReporter, Reporter
-from .run_state import diverged, policy_file, restore_run_state, run_state, save_run
+from .run_state import policy_file, restore_run_state, run_state, save_run
 from .rundir import (
     default_run_dir,
     lock_run_dir,
@@ -50,9 +51,9 @@ from .rundir import (
     write_plot,
 )
 from .schedule import batch_size_at
-from .scheduled_update import scheduled_updates
 from .signals import stop_on_signals
 from .snapshot import training_snapshot
+from .training_loop import train_until
 
 
 @dataclass
@@ -99,9 +100,9 @@ class Trainer:
         self.last_eval: dict | None = None
         self.full_eval: dict | None = None
         self.last_metrics: dict[str, float] = {}
-        self._update_metrics: Mapping[str, torch.Tensor] | None = None  # last update's, unsynced
+        self.update_metrics: Mapping[str, torch.Tensor] | None = None  # last update's, unsynced
         self.curriculum: dict[str, Any] | None = None  # set by curriculum.py
-        self._stop_signal: int | None = None  # set by request_stop
+        self.stop_signal: int | None = None  # set by request_stop
         # called after each periodic evaluation (and full test); True stops the run as
         # "pruned" (bipedal sweep's pruner)
         self.on_evaluation: Callable[[Trainer], bool] | None = None
@@ -127,7 +128,7 @@ class Trainer:
     # ------------------------------------------------------------------ loop
     def request_stop(self, signum: int = signal.SIGINT) -> None:
         """Stop after the current env step, with a checkpoint (the first Ctrl-C or SIGTERM)."""
-        self._stop_signal = signum
+        self.stop_signal = signum
         name = "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
         self.reporter.log(f"{name}: saving a checkpoint and stopping (again to abort)")
 
@@ -145,7 +146,7 @@ class Trainer:
             self.save()  # step 0: a run killed before its first periodic checkpoint resumes
         metrics = MetricsWriter(self.run_dir / METRICS_FILE)
         with stop_on_signals(self.request_stop):
-            stopped, steps_per_s = self._loop(metrics, total, until_solved)
+            stopped, steps_per_s = train_until(self, metrics, total, until_solved)
         self.save()
         self.write_plot()
         self.reporter.update(self.snapshot(steps_per_s))
@@ -158,46 +159,9 @@ class Trainer:
             stopped,
             self.last_eval,
             self.full_eval,
-            self._stop_signal if stopped == "interrupted" else None,
+            self.stop_signal if stopped == "interrupted" else None,
             self.env_steps,
         )
-
-    def _loop(self, metrics: MetricsWriter, total: int, until_solved: bool) -> tuple[str, float]:
-        """Policy steps and updates until the budget, a stop request or a solved test."""
-        t = self.cfg.train
-        self.reporter.start(self.step, total)
-        stopped = "budget"
-        session_start = time.perf_counter()
-        wall_base = self.wall_time
-        rate_t, rate_step = session_start, self.step
-        steps_per_s = 0.0
-        if self.runner.obs is None:
-            self.start_episode()
-        try:
-            while self.step < total:
-                if self._stop_signal is not None:
-                    stopped = "interrupted"
-                    break
-                self._env_step(metrics, wall_base, session_start)
-                if self.learning():
-                    self._update_metrics = scheduled_updates(self) or self._update_metrics
-                self.wall_time = wall_base + time.perf_counter() - session_start
-                if t.eval_every and self.step % t.eval_every == 0:
-                    outcome = periodic_evaluation(self, metrics, until_solved)
-                    if outcome is not None:
-                        stopped = outcome
-                        break
-                if t.checkpoint_every and self.step % t.checkpoint_every == 0:
-                    self.save()
-                if self.step % 50 == 0:
-                    now = time.perf_counter()
-                    steps_per_s = (self.step - rate_step) / max(now - rate_t, 1e-9)
-                    if now - rate_t > 5:
-                        rate_t, rate_step = now, self.step
-                    self.reporter.update(self.snapshot(steps_per_s))
-        finally:
-            self.wall_time = wall_base + time.perf_counter() - session_start
-        return stopped, steps_per_s
 
     def learning(self) -> bool:
         """Updates run after the warm-up, and after a restart's refill (``refill_until``)."""
@@ -212,25 +176,8 @@ class Trainer:
         """The next training episode (:func:`~bipedal_cli.episode_record.start_episode`)."""
         start_episode(self)
 
-    def _env_step(self, metrics: MetricsWriter, wall_base: float, session_start: float) -> None:
-        t = self.cfg.train
-        if self.step < t.warmup_steps and t.init_policy is None:
-            action = self.rng.uniform(-1.0, 1.0, self.act_dim).astype(np.float32)
-        else:
-            action = self.agent.act(self.runner.obs, deterministic=self.runner.episode.probe)
-            if not np.isfinite(action).all():  # Box2D must never see a NaN action
-                raise diverged(self, "the policy's action")
-        env_steps_before = self.runner.episode.env_steps
-        finished = self.runner.step(action)
-        self.step += 1
-        self.env_steps += self.runner.episode.env_steps - env_steps_before
-        if finished is not None:
-            self.wall_time = wall_base + time.perf_counter() - session_start
-            record_episode(self, finished, metrics)
-            self.start_episode()
-
     def loss_metrics(self) -> dict[str, float]:
-        m = self._update_metrics
+        m = self.update_metrics
         if m is None:
             return {}
         self.last_metrics = {

@@ -9,6 +9,7 @@ import torch
 
 from bipedal_cli import scheduled_update
 from bipedal_cli.adam_moments import (
+    accumulate_moments,
     estimate_moments,
     moment_batches,
     moments_missing,
@@ -63,7 +64,7 @@ def test_accumulated_moments_are_the_gradients_of_an_update_at_fixed_weights():
     batch = a_batch(agent)
     before = weights(agent)
     noise = agent.noise.get_state()
-    agent.accumulate_moments(batch)
+    accumulate_moments(agent, batch)
     assert all(torch.equal(a, b) for a, b in zip(before, weights(agent), strict=True))
     assert not moments_missing(agent) and not agent.alpha_opt.state  # the temperature waits
     # the same gradients by hand: the noise the update would draw, both losses, no step
@@ -74,8 +75,8 @@ def test_accumulated_moments_are_the_gradients_of_an_update_at_fixed_weights():
     reference.noise.set_state(noise)
     eps = torch.randn((2, 16, 4), generator=reference.noise)
     alpha = reference.log_alpha.detach().exp()
-    reference._critic_gradients(batch, eps[1], alpha)
-    reference._actor_gradients(batch["obs"], eps[0], alpha)
+    reference.critic_gradients(batch, eps[1], alpha)
+    reference.actor_gradients(batch["obs"], eps[0], alpha)
     for net, opt in ((reference.critic, agent.critic_opt), (reference.actor, agent.actor_opt)):
         for p_ref, p in zip(net.parameters(), opt.param_groups[0]["params"], strict=True):
             g = p_ref.grad

@@ -13,6 +13,7 @@ from bipedal_cli.config import config_from_dict
 from bipedal_cli.envs import RewardShaping, make_env
 from bipedal_cli.evaluation import evaluate_actor
 from bipedal_cli.train import Trainer, train
+from bipedal_cli.training_loop import WallClock, env_step
 
 from .conftest import tiny_dict
 
@@ -84,7 +85,7 @@ def test_the_loop_stores_terminated_only_at_falls_never_at_time_limits(monkeypat
     trainer = Trainer(config_from_dict(tiny_dict(total_steps=120, warmup_steps=200)), "unused")
     trainer.start_episode()
     for _ in range(120):
-        trainer._env_step(_NoMetrics(), 0.0, 0.0)
+        env_step(trainer, _NoMetrics(), WallClock(0.0))
     stored = trainer.buffer.terminated[: len(steps_seen)].tolist()
     assert len(steps_seen) == 120 == len(trainer.buffer)
     assert stored == [float(term) for term, _ in steps_seen]
