@@ -77,15 +77,17 @@ class TQCAgent:
 
     # ------------------------------------------------------------------ acting
     @torch.inference_mode()
-    def act(self, obs: np.ndarray, deterministic: bool = False) -> np.ndarray:
-        """obs: (obs_dim,) or (B, obs_dim) -> action(s) in [-1, 1]."""
+    def act(self, obs: np.ndarray, deterministic: bool = False, actor=None) -> np.ndarray:
+        """obs: (obs_dim,) or (B, obs_dim) -> action(s) in [-1, 1], by ``actor`` (default: the
+        agent's own), sampled with the agent's noise generator unless ``deterministic``."""
+        actor = self.actor if actor is None else actor
         x = torch.as_tensor(obs, dtype=torch.float32, device=self.device)
         single = x.dim() == 1
         x = x.unsqueeze(0) if single else x
         if deterministic:
-            action = self.actor.deterministic(x)
+            action = actor.deterministic(x)
         else:
-            action = self.actor.sample_action(x, generator=self.noise)
+            action = actor.sample_action(x, generator=self.noise)
         action = action.cpu().numpy()
         return action[0] if single else action
 

@@ -15,6 +15,7 @@ BRANCH_MAY_CHANGE = (
     "train.total_steps",
     "train.keep_policies",
     "train.refill_steps",  # read only when a run restarts from a restart.pt
+    "train.refill_policies",  # the same
 )
 BUFFER_SIZE = "train.buffer_size"  # only while the run's buffer has never wrapped
 # Features that start at a policy step: (their keys, the key of that step, is-on, its step).

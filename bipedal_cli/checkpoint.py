@@ -186,17 +186,33 @@ POLICY_SHAPE_KEYS = (
 
 def initial_actor_state(cfg: Any, obs_dim: int, act_dim: int) -> dict[str, torch.Tensor]:
     """The actor weights a new run starts from, ``train.init_policy``'s: a policy file (or a
-    ``state.pt``) whose bytes match ``train.init_policy_sha256`` when that is set, for the same
-    observation and action sizes, and whose actor has this config's shape and inputs
+    ``state.pt``) whose bytes match ``train.init_policy_sha256`` when that is set
+    (:func:`matching_actor_state`)."""
+    t = cfg.train
+    return matching_actor_state(
+        t.init_policy, "train.init_policy", cfg, obs_dim, act_dim, t.init_policy_sha256
+    )
+
+
+def matching_actor_state(
+    path: str | Path,
+    option: str,
+    cfg: Any,
+    obs_dim: int,
+    act_dim: int,
+    sha256: str | None = None,
+) -> dict[str, torch.Tensor]:
+    """The actor weights of the policy file (or ``state.pt``) at ``path``, named ``option`` in
+    errors: its bytes must match ``sha256`` when that is given, its observation and action sizes
+    ``obs_dim`` and ``act_dim``, and its actor this config's shape and inputs
     (:data:`POLICY_SHAPE_KEYS`). Every mismatch is one line naming the file."""
-    option, path = "train.init_policy", Path(cfg.train.init_policy)
+    path = Path(path)
     data = load_checkpoint(path, option)  # a readable, well-formed checkpoint first
-    want = cfg.train.init_policy_sha256
-    if want is not None:
+    if sha256 is not None:
         got = hashlib.sha256(Path(data["path"]).read_bytes()).hexdigest()
-        if got != want:
+        if got != sha256:
             raise UserError(
-                f"{option} {path}: its sha256 is {got}, train.init_policy_sha256 expects {want}"
+                f"{option} {path}: its sha256 is {got}, {option}_sha256 expects {sha256}"
             )
     from .config import config_from_dict
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import torch
+
 from .branch_rules import check_branch_config
 from .checkpoint import (
     BEST_POLICY_FILE,
@@ -21,6 +23,7 @@ from .checkpoint import (
 )
 from .config import Config, config_from_dict, override_config
 from .curriculum import continue_curriculum
+from .envs import policy_dims
 from .errors import UserError
 from .metrics import (
     METRICS_FILE,
@@ -30,6 +33,7 @@ from .metrics import (
     restart_metrics_text,
 )
 from .paths import atomic_path, printable
+from .refill import load_refill_actors
 from .reporting import Reporter
 from .rundir import BRANCH_FILE, lock_run_dir, prepare_new_run_dir
 from .train import Trainer
@@ -174,6 +178,8 @@ def branch(
         cfg = override_config(state["config"], config_source, overrides, **(explicit or {}))
     check_branch_config(run_cfg, cfg, step, config_source, state["buffer"])
     check_budget(cfg.train.total_steps, step, "--steps (train.total_steps)")
+    if restart is not None:  # the refill's policies are read before anything is written
+        load_refill_actors(cfg, *policy_dims(cfg.env, cfg.agent), torch.device("cpu"))
     into = prepare_new_run_dir(into, "--into")
     with lock_run_dir(into):
         trainer = Trainer(cfg, into, reporter)

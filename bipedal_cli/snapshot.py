@@ -46,7 +46,7 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         "phase": (
             "warm-up"
             if trainer.step < t.warmup_steps
-            else "refilling replay"  # restarted from a restart.pt: acting, no updates yet
+            else refill_phase(t)  # restarted from a restart.pt: acting, no updates yet
             if trainer.step < trainer.refill_until
             else "critics only"  # agent.actor_update_start: the actor and alpha wait
             if actor_frozen(trainer.step, trainer.cfg.agent)
@@ -106,3 +106,9 @@ def training_snapshot(trainer: Any, steps_per_s: float) -> dict[str, Any]:
         "falls_remembered": len(trainer.fall_memory) if restarts_on(t, trainer.step) else None,
         **trainer.last_metrics,
     }
+
+
+def refill_phase(t: Any) -> str:
+    """The display's phase while a restart refills its buffer, with how many policies play."""
+    n = len(t.refill_policies)
+    return f"refilling replay ({n} policies in turn)" if n else "refilling replay"

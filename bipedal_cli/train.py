@@ -93,6 +93,7 @@ class Trainer:
         self.step = 0  # policy steps
         self.env_steps = 0
         self.refill_until = 0  # a restart from a restart.pt: no updates up to this policy step
+        self.refill_actors: list | None = None  # train.refill_policies' (refill.py)
         self.episodes = 0
         self.wall_time = 0.0
         self.recent_returns: deque[float] = deque(maxlen=100)

@@ -4,7 +4,7 @@ the learner sees (shaping, curation, obstacle mix, restarts near falls), as a ty
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 
 @dataclass
@@ -126,6 +126,11 @@ class TrainConfig:
     """A run continued from a ``restart.pt`` (no replay buffer: ``bipedal resume FILE --into
     DIR``) first acts this many policy steps with its own actor, without updates, to refill the
     buffer it lost; then learning goes on. Changes nothing in a run that is not restarted."""
+    refill_policies: list[str] = field(default_factory=list)
+    """Policy files the refill acts with instead of the restart's own actor, one per episode in
+    turn (episode e by file e mod K), each sampling from its own Gaussian with the run's noise:
+    a mixture of earlier policies, as a run's own buffer holds. They must have this config's
+    action repeat, history and actor shape. Empty: the restart's own actor."""
 
     def obstacle_weights(self) -> tuple[float, float, float]:
         """The weights of stump, stairs and pit (``obstacle_stump``, ``_stairs``, ``_pit``)."""

@@ -12,6 +12,7 @@ import numpy as np
 from .episode_record import record_episode
 from .metrics import MetricsWriter
 from .periodic_eval import periodic_evaluation
+from .refill import refill_actor
 from .run_state import diverged
 from .scheduled_update import scheduled_updates
 
@@ -79,13 +80,15 @@ def train_until(
 
 def env_step(trainer: Any, metrics: MetricsWriter, clock: WallClock) -> None:
     """One policy step: uniform random actions during the warm-up (unless ``train.init_policy``
-    gives a policy to start from), else the actor's (its mean in a probe episode); an episode
+    gives a policy to start from), else the actor's (its mean in a probe episode; a refill
+    policy's in a restart's refill with ``train.refill_policies``); an episode
     that ends is booked and the next one started."""
     t = trainer.cfg.train
     if trainer.step < t.warmup_steps and t.init_policy is None:
         action = trainer.rng.uniform(-1.0, 1.0, trainer.act_dim).astype(np.float32)
     else:
-        action = trainer.agent.act(trainer.runner.obs, deterministic=trainer.runner.episode.probe)
+        probe = trainer.runner.episode.probe
+        action = trainer.agent.act(trainer.runner.obs, probe, actor=refill_actor(trainer))
         if not np.isfinite(action).all():  # Box2D must never see a NaN action
             raise diverged(trainer, "the policy's action")
     env_steps_before = trainer.runner.episode.env_steps

@@ -38,7 +38,11 @@ def _coerce(value: Any, tp: Any, key: str, source: str) -> Any:
             except UserError:
                 pass
         raise UserError(f"{source}: key {key!r} expects {_type_name(tp)}, got {value!r}")
-    if tp is bool:
+    if origin is list:
+        (item,) = typing.get_args(tp)
+        if isinstance(value, list):
+            return [_coerce(v, item, f"{key}[{i}]", source) for i, v in enumerate(value)]
+    elif tp is bool:
         if isinstance(value, bool):
             return value
     elif tp is int:

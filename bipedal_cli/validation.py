@@ -62,6 +62,11 @@ def validate(cfg: Any, source: str) -> None:
         *agent_checks(a, t.init_policy),
         (t.init_policy != "", "train.init_policy", "null or the path of a policy file"),
         (
+            all(p != "" for p in t.refill_policies),
+            "train.refill_policies",
+            "a list of policy files' paths (empty: the restart's own actor)",
+        ),
+        (
             t.init_policy_sha256 is None or re.fullmatch("[0-9a-f]{64}", t.init_policy_sha256),
             "train.init_policy_sha256",
             "null or 64 lowercase hex digits (sha256sum's output)",
