@@ -55,9 +55,9 @@ def test_probes_act_deterministically_and_only_their_falls_are_remembered(tmp_pa
     calls = []
     act = trainer.agent.act
 
-    def spy(obs, deterministic=False):
+    def spy(obs, deterministic=False, actor=None):
         calls.append((deterministic, trainer.runner.episode.probe))
-        return act(obs, deterministic)
+        return act(obs, deterministic, actor=actor)
 
     trainer.agent.act = spy
     trainer.run()
