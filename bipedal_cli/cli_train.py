@@ -142,6 +142,14 @@ def resume(
         list[str] | None,
         typer.Option("--set", help="With --into: override a key of the branch's config."),
     ] = None,
+    refill_policy: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--refill-policy",
+            help="With --into from a restart.pt: a policy file that plays the refill, one "
+            "episode each in turn with the others given (repeat it; train.refill_policies).",
+        ),
+    ] = None,
 ) -> None:
     """Continue a run exactly where its last checkpoint left it (or branch it with --into)."""
     from .devices import resolve_device
@@ -151,9 +159,10 @@ def resume(
 
     if steps is not None and steps < 0:
         raise UserError(f"--steps {steps}: expected the new total, a non-negative integer")
-    if into is None and (config is not None or set_):
+    if into is None and (config is not None or set_ or refill_policy):
         raise UserError(
-            "--config and --set: only with --into (a branch); a resume keeps its config"
+            "--config, --set and --refill-policy: only with --into (a branch); a resume keeps "
+            "its config"
         )
     if device:
         resolve_device(device)
@@ -164,6 +173,7 @@ def resume(
             "train.threads": threads,
             "train.total_steps": steps,
             "train.keep_policies": keep_policies,
+            "train.refill_policies": [str(p) for p in refill_policy] if refill_policy else None,
         }
         if config is not None:
             cfg = resolve_config(config, set_, **explicit)

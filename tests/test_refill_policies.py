@@ -125,3 +125,20 @@ def test_the_display_says_how_many_policies_refill():
     assert refill_phase(config_from_dict(tiny_dict()).train) == "refilling replay"
     two = config_from_dict(tiny_dict(refill_policies=["a.pt", "b.pt"])).train
     assert refill_phase(two) == "refilling replay (2 policies in turn)"
+
+
+def test_cli_names_the_refill_policies_with_a_repeated_option(tmp_path, stopped_run, capsys):
+    from .test_cli import run_cli
+
+    first, second = kept(stopped_run, 100), kept(stopped_run, 200)
+    into = tmp_path / "cli"
+    args = ["resume", tmp_path / "restart.pt", "--into", into, "--steps", 280]
+    code, out, err = run_cli([*args, "--refill-policy", first, "--refill-policy", second], capsys)
+    assert code == 0, err
+    state = load_checkpoint(into / "state.pt")
+    assert state["config"]["train"]["refill_policies"] == [str(first), str(second)]
+    code, out, err = run_cli(["resume", stopped_run, "--refill-policy", first], capsys)
+    assert code == 2 and "only with --into" in err and len(err.strip().splitlines()) == 1
+    code, out, err = run_cli([*args[:3], tmp_path / "bad", "--refill-policy", tmp_path], capsys)
+    assert code == 2 and "train.refill_policies[0]" in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "bad").exists()
