@@ -173,7 +173,8 @@ def resume(
             "train.threads": threads,
             "train.total_steps": steps,
             "train.keep_policies": keep_policies,
-            "train.refill_policies": [str(p) for p in refill_policy] if refill_policy else None,
+            # resolved, so that a resume inside the refill finds them from any directory
+            "train.refill_policies": [str(p.resolve()) for p in refill_policy or []] or None,
         }
         if config is not None:
             cfg = resolve_config(config, set_, **explicit)

@@ -127,13 +127,19 @@ def test_the_display_says_how_many_policies_refill():
     assert refill_phase(two) == "refilling replay (2 policies in turn)"
 
 
-def test_cli_names_the_refill_policies_with_a_repeated_option(tmp_path, stopped_run, capsys):
+def test_cli_names_the_refill_policies_with_a_repeated_option(
+    tmp_path, stopped_run, capsys, monkeypatch
+):
     from .test_cli import run_cli
 
     first, second = kept(stopped_run, 100), kept(stopped_run, 200)
     into = tmp_path / "cli"
     args = ["resume", tmp_path / "restart.pt", "--into", into, "--steps", 280]
-    code, out, err = run_cli([*args, "--refill-policy", first, "--refill-policy", second], capsys)
+    monkeypatch.chdir(stopped_run)  # a relative path is stored resolved
+    relative = first.relative_to(stopped_run)
+    code, out, err = run_cli(
+        [*args, "--refill-policy", relative, "--refill-policy", second], capsys
+    )
     assert code == 0, err
     state = load_checkpoint(into / "state.pt")
     assert state["config"]["train"]["refill_policies"] == [str(first), str(second)]
