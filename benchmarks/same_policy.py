@@ -18,12 +18,8 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bipedal_cli.checkpoint import (  # noqa: E402
-    POLICY_FORMAT,
-    actor_weights,
-    load_checkpoint,
-    training_progress,
-)
+from bipedal_cli.checkpoint import POLICY_FORMAT, actor_weights, load_checkpoint  # noqa: E402
+from bipedal_cli.checkpoint_contents import training_progress  # noqa: E402
 from bipedal_cli.errors import UserError  # noqa: E402
 
 COUNTERS = ("steps", "env_steps", "episodes")

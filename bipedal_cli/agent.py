@@ -67,11 +67,8 @@ class TQCAgent:
             worker.shutdown()
 
     def sync(self) -> None:
-        """Wait for the critics' step of the last update, which the worker may still be running.
-
-        Everything here that reads the critics calls it first; code outside that reads
-        ``critic``/``critic_target`` directly between updates must too.
-        """
+        """Wait for the critics' step of the last update, which the worker may still be running;
+        everything that reads ``critic``/``critic_target`` between updates calls it first."""
         if self._worker is not None:
             self._worker.wait()
 

@@ -111,38 +111,9 @@ def policy_step(path: Path) -> int:
     return int(load_checkpoint(path)["meta"]["steps"])
 
 
-def policy_payload(
-    actor_state: dict, config: dict, obs_dim: int, act_dim: int, meta: dict
-) -> dict[str, Any]:
-    return {
-        "format": POLICY_FORMAT,
-        "version": FORMAT_VERSION,
-        "config": config,
-        "env": config["env"],
-        "obs_dim": obs_dim,
-        "act_dim": act_dim,
-        "actor": {k: v.detach().cpu().clone() for k, v in actor_state.items()},
-        "meta": meta,
-    }
-
-
 def actor_weights(data: dict[str, Any]) -> dict[str, torch.Tensor]:
     """The actor's tensors of a checked policy file or training state."""
     return data["actor"] if data["format"] == POLICY_FORMAT else data["agent"]["actor"]
-
-
-def training_progress(data: dict[str, Any]) -> dict[str, Any]:
-    """Where a checked training state stands, under a policy file's ``meta`` names: policy
-    steps, env steps, episodes, wall time and its last and full evaluations."""
-    c = data["counters"]
-    return {
-        "steps": c["step"],
-        "env_steps": c.get("env_steps", c["step"]),
-        "episodes": c["episodes"],
-        "wall_time": round(c["wall_time"], 1),
-        "last_eval": data["last_eval"],
-        "full_eval": data["full_eval"],
-    }
 
 
 def actor_from_checkpoint(data: dict[str, Any], option: str = "CKPT"):

@@ -3,49 +3,16 @@ app by :mod:`bipedal_cli.cli`)."""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from .cli_common import DeviceOpt, EnvOpt, console
+from .cli_report import exit_if_interrupted, report_curriculum, report_result
 from .config import resolve_config
 from .env_ids import canonical_env_id
 from .errors import UserError
-from .paths import printable
-
-
-def _summary_line(result) -> str:
-    minutes = result.wall_time / 60
-    why = {
-        "budget": "step budget reached",
-        "solved": "solved",
-        "interrupted": "interrupted, checkpoint saved",
-        "pruned": "pruned by the sweep",
-    }[result.stopped]
-    return (
-        f"{why}: {result.steps:,} steps ({result.env_steps or result.steps:,} env steps), "
-        f"{result.episodes:,} episodes, "
-        f"{minutes:.1f} min; run directory {printable(result.run_dir)}"
-    )
-
-
-def _report_result(result) -> None:
-    from .display import eval_table, verdict
-
-    console.print(_summary_line(result))
-    if result.full_eval:
-        console.print(eval_table(result.full_eval, "full evaluation"))
-        console.print(verdict(result.full_eval))
-    elif result.last_eval:
-        e = result.last_eval
-        console.print(
-            f"last evaluation ({e['episodes']} episodes at step {e['step']:,}): "
-            f"{e['mean']:.1f} +- {e['std']:.1f}"
-        )
-    run_dir = printable(result.run_dir)
-    console.print(f"policy: {run_dir}/policy.pt   resume: bipedal resume {run_dir}")
 
 
 def train(
@@ -84,16 +51,8 @@ def train(
         },
     )
     result = train_run(cfg, run_dir, TrainingDisplay(console, cfg.env), until_solved)
-    _report_result(result)
-    _exit_if_interrupted(result)
-
-
-def _exit_if_interrupted(result) -> None:
-    """128 + the signal's number after a run stopped by Ctrl-C (130) or SIGTERM (143)."""
-    if result.signal is not None:
-        from .signals import exit_status
-
-        sys.exit(exit_status(result.signal))
+    report_result(result)
+    exit_if_interrupted(result)
 
 
 def resume(
@@ -186,10 +145,10 @@ def resume(
     else:
         result = resume_run(run, steps, display, until_solved, device, threads, keep_policies)
     if hasattr(result, "stages"):
-        _report_curriculum(result)
+        report_curriculum(result)
     else:
-        _report_result(result)
-    _exit_if_interrupted(result)
+        report_result(result)
+    exit_if_interrupted(result)
 
 
 def curriculum(
@@ -227,12 +186,5 @@ def curriculum(
         },
     )
     result = start_curriculum(cfg, run_dir, TrainingDisplay(console, "curriculum"))
-    _report_curriculum(result)
-    _exit_if_interrupted(result)
-
-
-def _report_curriculum(result) -> None:
-    from .display import curriculum_table
-
-    console.print(curriculum_table(result, printable(result.run_dir)))
-    console.print(f"resume: bipedal resume {printable(result.run_dir)}")
+    report_curriculum(result)
+    exit_if_interrupted(result)

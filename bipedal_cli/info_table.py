@@ -24,7 +24,8 @@ def _brief(value: Any) -> str:
 
 def checkpoint_table(data: dict, title: str) -> Table:
     """``bipedal info``: what a checkpoint (already checked by checkpoint.py) holds."""
-    from .checkpoint import TRAIN_FORMAT, training_progress
+    from .checkpoint import TRAIN_FORMAT
+    from .checkpoint_contents import training_progress
     from .config import config_from_dict
 
     cfg = config_from_dict(data["config"])

@@ -16,6 +16,7 @@ from typing import Any
 import torch
 
 from .checkpoint import matching_actor_state
+from .envs import policy_dims
 from .networks import make_actor
 
 
@@ -36,6 +37,12 @@ def load_refill_actors(cfg: Any, obs_dim: int, act_dim: int, device: torch.devic
         actor.load_state_dict(weights)
         actors.append(actor.to(device).eval())
     return actors
+
+
+def check_refill_policies(cfg: Any) -> None:
+    """Read ``cfg.train.refill_policies`` once, on CPU, so that a bad file stops a restart in one
+    line before its run directory is made."""
+    load_refill_actors(cfg, *policy_dims(cfg.env, cfg.agent), torch.device("cpu"))
 
 
 def refill_policy_index(step: int, refill_until: int, episodes: int, n_policies: int) -> int | None:

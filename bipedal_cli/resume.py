@@ -9,8 +9,6 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-import torch
-
 from .branch_rules import check_branch_config
 from .checkpoint import (
     BEST_POLICY_FILE,
@@ -23,7 +21,6 @@ from .checkpoint import (
 )
 from .config import Config, config_from_dict, override_config
 from .curriculum import continue_curriculum
-from .envs import policy_dims
 from .errors import UserError
 from .metrics import (
     METRICS_FILE,
@@ -33,7 +30,7 @@ from .metrics import (
     restart_metrics_text,
 )
 from .paths import atomic_path, printable
-from .refill import load_refill_actors
+from .refill import check_refill_policies
 from .reporting import Reporter
 from .rundir import BRANCH_FILE, lock_run_dir, prepare_new_run_dir
 from .train import Trainer
@@ -87,12 +84,10 @@ def load_trainer(
     threads: int | None = None,
     keep_policies: bool | None = None,
 ) -> Trainer:
-    """A Trainer restored from ``path`` (a run directory or its ``state.pt``), ready to run.
-
+    """A Trainer restored from ``path`` (a run directory or its ``state.pt``), ready to run;
     ``total_steps`` (the new budget) is checked against the run's step before anything is
-    written; ``threads`` and ``keep_policies`` replace ``train.threads`` and
-    ``train.keep_policies`` (neither changes the run's bits).
-    """
+    written, ``threads`` and ``keep_policies`` replace ``train.threads`` and
+    ``train.keep_policies`` (neither changes the run's bits)."""
     state_path, state = load_training_state(path)
     step = int(state["counters"]["step"])
     if total_steps is not None:
@@ -122,11 +117,8 @@ def resume(
     threads: int | None = None,
     keep_policies: bool | None = None,
 ):
-    """Continue the run at ``path``; a curriculum run continues inside its current stage.
-
-    Returns a :class:`~bipedal_cli.train.TrainResult`, or a ``CurriculumResult`` for a
-    curriculum run.
-    """
+    """Continue the run at ``path``: a :class:`~bipedal_cli.train.TrainResult`, or for a
+    curriculum run (which continues inside its current stage) a ``CurriculumResult``."""
     run_dir = state_path_of(path).parent
     with lock_run_dir(run_dir):
         trainer = load_trainer(path, reporter, device, total_steps, threads, keep_policies)
@@ -178,8 +170,8 @@ def branch(
         cfg = override_config(state["config"], config_source, overrides, **(explicit or {}))
     check_branch_config(run_cfg, cfg, step, config_source, state["buffer"])
     check_budget(cfg.train.total_steps, step, "--steps (train.total_steps)")
-    if restart is not None:  # the refill's policies are read before anything is written
-        load_refill_actors(cfg, *policy_dims(cfg.env, cfg.agent), torch.device("cpu"))
+    if restart is not None:
+        check_refill_policies(cfg)
     into = prepare_new_run_dir(into, "--into")
     with lock_run_dir(into):
         trainer = Trainer(cfg, into, reporter)

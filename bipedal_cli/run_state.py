@@ -22,8 +22,8 @@ from .checkpoint import (
     STATE_FILE,
     TRAIN_FORMAT,
     atomic_save,
-    policy_payload,
 )
+from .checkpoint_contents import policy_payload
 from .devices import machine_summary
 from .errors import UserError
 from .metrics import METRICS_FILE, pack_metrics

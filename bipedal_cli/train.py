@@ -4,8 +4,7 @@ the loop itself (warm-up, TQC updates, evaluations, checkpoints) is
 
 A run lives in one directory (:mod:`bipedal_cli.rundir`): ``config.yaml``, ``metrics.csv``,
 ``state.pt`` (everything an exact resume needs), ``restart.pt`` (the same without the replay
-buffer: small enough to commit, so that a run outlives its directory) and ``policy.pt`` (the
-actor alone).
+buffer: small enough to commit) and ``policy.pt`` (the actor alone).
 
 Exact resume (:mod:`bipedal_cli.run_state`): every source of randomness is checkpointed, and an
 episode cut by a checkpoint is rebuilt by replaying it. Periodic evaluations, best and kept

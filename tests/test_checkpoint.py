@@ -5,6 +5,7 @@ import torch
 
 from bipedal_cli import checkpoint as ckpt_mod
 from bipedal_cli.checkpoint import actor_from_checkpoint, atomic_save, load_checkpoint
+from bipedal_cli.checkpoint_contents import policy_payload
 from bipedal_cli.config import config_from_dict
 from bipedal_cli.errors import UserError
 from bipedal_cli.train import Trainer, train
@@ -44,7 +45,7 @@ def tiny_policy_payload(fill: float) -> dict:
     with torch.no_grad():
         for p in actor.parameters():
             p.fill_(fill)
-    return ckpt_mod.policy_payload(actor.state_dict(), cfg.to_dict(), 24, 4, {})
+    return policy_payload(actor.state_dict(), cfg.to_dict(), 24, 4, {})
 
 
 def test_interrupted_write_leaves_the_previous_checkpoint_loadable(tmp_path, monkeypatch):
