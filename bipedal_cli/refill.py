@@ -17,6 +17,7 @@ import torch
 
 from .checkpoint import matching_actor_state
 from .envs import policy_dims
+from .errors import UserError
 from .networks import make_actor
 
 
@@ -41,8 +42,14 @@ def load_refill_actors(cfg: Any, obs_dim: int, act_dim: int, device: torch.devic
 
 def check_refill_policies(cfg: Any) -> None:
     """Read ``cfg.train.refill_policies`` once, on CPU, so that a bad file stops a restart in one
-    line before its run directory is made."""
-    load_refill_actors(cfg, *policy_dims(cfg.env, cfg.agent), torch.device("cpu"))
+    line before its run directory is made. A restart file's config keeps the list its own run was
+    refilled with, so the line says how to name others, or none."""
+    try:
+        load_refill_actors(cfg, *policy_dims(cfg.env, cfg.agent), torch.device("cpu"))
+    except UserError as err:
+        raise UserError(
+            f"{err}; name others with --refill-policy, or none with --set train.refill_policies=[]"
+        ) from None
 
 
 def refill_policy_index(step: int, refill_until: int, episodes: int, n_policies: int) -> int | None:

@@ -148,3 +148,20 @@ def test_cli_names_the_refill_policies_with_a_repeated_option(
     code, out, err = run_cli([*args[:3], tmp_path / "bad", "--refill-policy", tmp_path], capsys)
     assert code == 2 and "train.refill_policies[0]" in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1 and not (tmp_path / "bad").exists()
+
+
+def test_a_restart_file_naming_lost_policies_says_how_to_refill_without_them(tmp_path, stopped_run):
+    """A restarted run's own restart.pt keeps its refill policies in its config; after a move
+    they may be gone, and the refusal says how to name others or none."""
+    moved = tmp_path / "moved.pt"
+    lost = tmp_path / "lost-policy.pt"
+    shutil.copyfile(kept(stopped_run, 100), lost)
+    restarted(tmp_path, "first", [lost], total=240, refill=5)
+    shutil.copyfile(tmp_path / "first" / "restart.pt", moved)
+    lost.unlink()
+    with pytest.raises(UserError, match=r"lost-policy.pt: no such file; .*refill_policies=\[\]"):
+        branch(moved, tmp_path / "second", explicit={"train.total_steps": 260})
+    assert not (tmp_path / "second").exists()
+    branch(moved, tmp_path / "second", overrides=["train.refill_policies=[]"])
+    state = load_checkpoint(tmp_path / "second" / "state.pt")
+    assert state["config"]["train"]["refill_policies"] == []
