@@ -40,12 +40,13 @@ def load_refill_actors(cfg: Any, obs_dim: int, act_dim: int, device: torch.devic
     return actors
 
 
-def check_refill_policies(cfg: Any) -> None:
-    """Read ``cfg.train.refill_policies`` once, on CPU, so that a bad file stops a restart in one
-    line before its run directory is made. A restart file's config keeps the list its own run was
-    refilled with, so the line says how to name others, or none."""
+def checked_refill_actors(cfg: Any) -> list[Any]:
+    """The actors of ``cfg.train.refill_policies`` on CPU, read before a restart's run directory
+    is made, so that a bad file stops it in one line; the trainer then acts with these. A restart
+    file's config keeps the list its own run was refilled with, so the line says how to name
+    others, or none."""
     try:
-        load_refill_actors(cfg, *policy_dims(cfg.env, cfg.agent), torch.device("cpu"))
+        return load_refill_actors(cfg, *policy_dims(cfg.env, cfg.agent), torch.device("cpu"))
     except UserError as err:
         raise UserError(
             f"{err}; name others with --refill-policy, or none with --set train.refill_policies=[]"

@@ -30,7 +30,7 @@ from .metrics import (
     restart_metrics_text,
 )
 from .paths import atomic_path, printable
-from .refill import check_refill_policies
+from .refill import checked_refill_actors
 from .reporting import Reporter
 from .rundir import BRANCH_FILE, lock_run_dir, prepare_new_run_dir
 from .train import Trainer
@@ -170,14 +170,14 @@ def branch(
         cfg = override_config(state["config"], config_source, overrides, **(explicit or {}))
     check_branch_config(run_cfg, cfg, step, config_source, state["buffer"])
     check_budget(cfg.train.total_steps, step, "--steps (train.total_steps)")
-    if restart is not None:
-        check_refill_policies(cfg)
+    refill_actors = checked_refill_actors(cfg) if restart is not None else None
     into = prepare_new_run_dir(into, "--into")
     with lock_run_dir(into):
         trainer = Trainer(cfg, into, reporter)
         trainer.load_state_dict(state)
         if restart is not None:
             trainer.refill_until = step + cfg.train.refill_steps
+            trainer.refill_actors = [actor.to(trainer.device) for actor in refill_actors]
             rows = parse_metrics(restart_metrics_text(restart))
             origin = f"restart file {state_path.resolve()} at step {step}"
         else:
