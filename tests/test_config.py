@@ -51,6 +51,7 @@ SHIPPED = {
     "hardcore-lrdecay-cvar25-stumps": HARDCORE_H4,
     "hardcore-lrdecay-cvar10-ere": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-buffer2m": HARDCORE_H4,
+    "hardcore-lrdecay-cvar25-buffer2m-stumps4": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-smooth": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-entropy8": HARDCORE_H4,
     "hardcore-lrdecay-cvar25-drop4": HARDCORE_H4,
@@ -312,6 +313,28 @@ def test_the_buffer2m_config_is_its_seed_0_run_with_a_buffer_that_never_wraps_be
         )
     big.train.buffer_size = 1_000_000
     assert big == seed0
+
+
+def test_the_buffer2m_stumps4_config_is_the_2m_run_branched_at_1m_with_four_times_the_stumps():
+    """Session 55's branch: the 2M-buffer run from its full state at 1M, with stumps weighted 4
+    against 1 from there. The branch check accepts it at 1M, not a step later, and nothing but
+    the obstacle weights differs."""
+    from bipedal_cli.branch_rules import check_branch_config
+    from bipedal_cli.episodes import obstacle_mix_on
+
+    big, stumps = (
+        resolve_config(CONFIGS / f"hardcore-lrdecay-cvar25-{n}.yaml")
+        for n in ("buffer2m", "buffer2m-stumps4")
+    )
+    t = stumps.train
+    assert (t.obstacle_stump, t.obstacle_stairs, t.obstacle_pit) == (4.0, 1.0, 1.0)
+    assert not obstacle_mix_on(t, 999_999) and obstacle_mix_on(t, 1_000_000)
+    name = "hardcore-lrdecay-cvar25-buffer2m-stumps4.yaml"
+    check_branch_config(big, stumps, 1_000_000, name)
+    with pytest.raises(UserError, match="obstacle_mix_start"):
+        check_branch_config(big, stumps, 1_000_001, name)
+    t.obstacle_stump, t.obstacle_mix_start = 1.0, TrainConfig().obstacle_mix_start
+    assert stumps == big
 
 
 # session 49's candidates: (their agent keys from 1.1M, the key the branch check names)
